@@ -1,0 +1,25 @@
+//! `pathlight`: a progressive GPU path tracer. See `pathlight --help`.
+
+mod cli;
+mod output;
+mod progress;
+mod render_cmd;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+fn main() -> ExitCode {
+    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    let cli = cli::Cli::parse();
+    let result = match cli.command {
+        cli::Command::Render(args) => render_cmd::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(err) => {
+            eprintln!("error: {err:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,188 @@
+//! Host structs shared with WGSL (`crates/render/shaders/scene.wgsl` declares each one).
+//!
+//! Every struct is `#[repr(C)]` + `Pod`, uses no `vec3` without the scalar that pads it to
+//! 16 bytes, and is pinned in size here and in field offsets by a naga test in
+//! `crates/render/tests/layout.rs`.
+
+use bytemuck::{Pod, Zeroable};
+
+/// [`GpuObject::kind`] of a parallelogram.
+pub const KIND_QUAD: u32 = 0;
+/// [`GpuObject::kind`] of a sphere.
+pub const KIND_SPHERE: u32 = 1;
+/// [`GpuObject::kind`] of a cylinder.
+pub const KIND_CYLINDER: u32 = 2;
+/// [`GpuObject::kind`] of a triangle mesh.
+pub const KIND_MESH: u32 = 3;
+
+/// [`GpuObject::flags`] bit: shade a mesh with geometric normals.
+pub const FLAG_FLAT: u32 = 1;
+/// [`GpuObject::flags`] bit: a cylinder closed by two disks.
+pub const FLAG_CAPS: u32 = 2;
+
+/// One object, a leaf of the top-level BVH. WGSL: `Object`.
+///
+/// Geometry by kind: quad `a` = origin, `b` = edge_u, `c` = edge_v; sphere `a.xyz` = centre,
+/// `a.w` = radius, `b.x` = texture rotation (radians); cylinder `a.xyz` = p0, `a.w` = radius,
+/// `b.xyz` = p1; mesh: the triangles under the BLAS rooted at `blas_root`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuObject {
+    /// First geometry vector.
+    pub a: [f32; 4],
+    /// Second geometry vector.
+    pub b: [f32; 4],
+    /// Third geometry vector.
+    pub c: [f32; 4],
+    /// `KIND_*`.
+    pub kind: u32,
+    /// Index into the material buffer.
+    pub material: u32,
+    /// Mesh only: index of the BLAS root in the node buffer.
+    pub blas_root: u32,
+    /// Index of the object in [`crate::Scene::objects`] (the top level reorders objects).
+    pub id: u32,
+    /// `FLAG_*` bits.
+    pub flags: u32,
+    /// Padding to 16 bytes.
+    pub pad: [u32; 3],
+}
+const _: () = assert!(size_of::<GpuObject>() == 80);
+
+/// One BVH2 node in the layout of `obvhs::bvh2::node::Bvh2Node`. WGSL: `BvhNode`.
+///
+/// If `prim_count` is 0 this is an inner node whose children are `first_index` and
+/// `first_index + 1`; otherwise it is a leaf holding primitives
+/// `first_index .. first_index + prim_count` (objects in the top level, triangles in a BLAS).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuBvhNode {
+    /// Box minimum corner.
+    pub aabb_min: [f32; 3],
+    /// Padding (obvhs' `Vec3A`).
+    pub pad0: u32,
+    /// Box maximum corner.
+    pub aabb_max: [f32; 3],
+    /// Padding (obvhs' `Vec3A`).
+    pub pad1: u32,
+    /// Number of primitives; 0 for an inner node.
+    pub prim_count: u32,
+    /// First child (inner) or first primitive (leaf).
+    pub first_index: u32,
+    /// Unused (obvhs' meta fields).
+    pub pad2: [u32; 2],
+}
+const _: () = assert!(size_of::<GpuBvhNode>() == 48);
+
+/// One triangle corner. WGSL: `Vertex`; a triangle is three consecutive vertices.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuVertex {
+    /// World position.
+    pub position: [f32; 3],
+    /// Texture coordinate u.
+    pub u: f32,
+    /// Shading normal (unit).
+    pub normal: [f32; 3],
+    /// Texture coordinate v.
+    pub v: f32,
+}
+const _: () = assert!(size_of::<GpuVertex>() == 32);
+
+/// A material in linear RGB. WGSL: `Material`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuMaterial {
+    /// Base colour.
+    pub base_color: [f32; 3],
+    /// Index into the texture table, or -1.
+    pub texture: i32,
+    /// Emitted radiance (front side).
+    pub emission: [f32; 3],
+    /// Weight of the specular lobe.
+    pub specular_rate: f32,
+    /// Conductor IOR, real part (when `conductor` is 1).
+    pub eta: [f32; 3],
+    /// Specular colour between white and base colour.
+    pub specular_tint: f32,
+    /// Conductor IOR, imaginary part (when `conductor` is 1).
+    pub k: [f32; 3],
+    /// Roughness of the specular lobe.
+    pub specular_roughness: f32,
+    /// Weight of the transmission lobe.
+    pub refract_rate: f32,
+    /// Transmitted colour between white and base colour.
+    pub refract_tint: f32,
+    /// Index of refraction of the inside.
+    pub ior: f32,
+    /// Roughness of transmission.
+    pub refract_roughness: f32,
+    /// 1: the specular lobe uses the complex-IOR conductor Fresnel; 0: Schlick.
+    pub conductor: u32,
+    /// Padding to 16 bytes.
+    pub pad: [u32; 3],
+}
+const _: () = assert!(size_of::<GpuMaterial>() == 96);
+
+/// Where a texture's texels lie in the texel buffer. WGSL: `TextureInfo`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuTextureInfo {
+    /// First texel.
+    pub offset: u32,
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Padding.
+    pub pad: u32,
+}
+const _: () = assert!(size_of::<GpuTextureInfo>() == 16);
+
+/// Per-batch constants of the integrator. WGSL: `FrameParams`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuFrameParams {
+    /// Eye position.
+    pub camera_position: [f32; 3],
+    /// Image width in pixels.
+    pub width: u32,
+    /// Unit view direction.
+    pub camera_forward: [f32; 3],
+    /// Image height in pixels.
+    pub height: u32,
+    /// Right vector scaled to half the image width at unit distance.
+    pub camera_right: [f32; 3],
+    /// Samples per pixel already accumulated before this batch.
+    pub sample_offset: u32,
+    /// Up vector scaled to half the image height at unit distance.
+    pub camera_up: [f32; 3],
+    /// Samples per pixel this batch adds.
+    pub batch_samples: u32,
+    /// Constant environment radiance.
+    pub environment: [f32; 3],
+    /// Maximum path length in segments.
+    pub max_depth: u32,
+    /// Depth from which Russian roulette applies.
+    pub rr_depth: u32,
+    /// Seed of the random sequence.
+    pub seed: u32,
+    /// Number of objects (0: the node buffer holds a placeholder).
+    pub object_count: u32,
+    /// First row this dispatch covers (long renders are split into row bands).
+    pub row_offset: u32,
+}
+const _: () = assert!(size_of::<GpuFrameParams>() == 96);
+
+/// One pixel of the accumulation buffer: a Kahan-compensated sum. WGSL: `AccumPixel`.
+///
+/// The running sum of all samples is `sum - compensation`; `sum.w` is unused.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuAccumPixel {
+    /// Running sum of sample radiance.
+    pub sum: [f32; 4],
+    /// Kahan compensation: the low-order part lost from `sum` (negated).
+    pub compensation: [f32; 4],
+}
+const _: () = assert!(size_of::<GpuAccumPixel>() == 32);

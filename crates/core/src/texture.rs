@@ -1,0 +1,57 @@
+//! Image textures: decoded once into packed sRGB8 texels (decoded to linear on the GPU).
+
+use std::path::Path;
+
+use crate::error::SceneError;
+use crate::scene::Texture;
+
+/// Largest accepted texture side, in texels.
+pub const MAX_TEXTURE_SIDE: u32 = 16384;
+
+impl Texture {
+    /// Decodes a PNG or JPEG held in memory; `path` only names it in errors.
+    pub fn decode(bytes: &[u8], path: &Path) -> Result<Self, SceneError> {
+        let image = image::load_from_memory(bytes).map_err(|err| SceneError::Asset {
+            path: path.to_owned(),
+            message: format!("cannot decode image: {err}"),
+        })?;
+        let rgba = image.to_rgba8();
+        let (width, height) = rgba.dimensions();
+        if width > MAX_TEXTURE_SIDE || height > MAX_TEXTURE_SIDE {
+            return Err(SceneError::Asset {
+                path: path.to_owned(),
+                message: format!(
+                    "image is {width}x{height}; the largest side accepted is {MAX_TEXTURE_SIDE}"
+                ),
+            });
+        }
+        let texels = rgba
+            .pixels()
+            .map(|p| u32::from_le_bytes(p.0))
+            .collect::<Vec<_>>();
+        Ok(Self {
+            width,
+            height,
+            texels,
+        })
+    }
+}
+
+/// The sRGB transfer function's inverse: encoded [0, 1] to linear.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// The sRGB transfer function: linear to encoded [0, 1] (input clamped to [0, 1]).
+pub fn linear_to_srgb(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}

@@ -1,0 +1,315 @@
+//! Ray queries on a [`GpuScene`] on the CPU: the twin of `intersect.wgsl` and `bvh.wgsl`
+//! (same names, same arithmetic), used to check the GPU traversal and for picking.
+
+use glam::Vec3;
+
+use crate::accel::GpuScene;
+use crate::gpu::{FLAG_CAPS, GpuBvhNode, KIND_CYLINDER, KIND_QUAD, KIND_SPHERE};
+
+/// Distance returned when there is no hit (WGSL `MISS`).
+pub const MISS: f32 = 3.0e38;
+/// Traversal stack depth (WGSL `STACK_SIZE`).
+const STACK_SIZE: usize = 64;
+
+/// A ray with a unit direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ray {
+    /// Start point.
+    pub origin: Vec3,
+    /// Unit direction.
+    pub dir: Vec3,
+}
+
+/// The nearest hit of a ray (WGSL `Hit`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    /// Distance along the ray.
+    pub t: f32,
+    /// Index into [`GpuScene::objects`] (top-level order).
+    pub object: u32,
+    /// Mesh: triangle index; other shapes: 0.
+    pub primitive: u32,
+    /// Triangle: barycentric of vertex 1; quad: s.
+    pub b1: f32,
+    /// Triangle: barycentric of vertex 2; quad: t.
+    pub b2: f32,
+}
+
+/// Slab test; twin of WGSL `intersect_aabb`. Returns the entry distance or [`MISS`].
+pub fn intersect_aabb(node: &GpuBvhNode, origin: Vec3, inv_dir: Vec3, t_max: f32) -> f32 {
+    let t0 = (Vec3::from(node.aabb_min) - origin) * inv_dir;
+    let t1 = (Vec3::from(node.aabb_max) - origin) * inv_dir;
+    let t_near =
+        t0.x.min(t1.x)
+            .max(t0.y.min(t1.y))
+            .max(t0.z.min(t1.z).max(0.0));
+    let t_far =
+        t0.x.max(t1.x)
+            .min(t0.y.max(t1.y))
+            .min(t0.z.max(t1.z).min(t_max));
+    if t_near <= t_far { t_near } else { MISS }
+}
+
+/// `1 / d` without infinities; twin of WGSL `safe_inverse`.
+pub fn safe_inverse(d: Vec3) -> Vec3 {
+    let tiny = 1e-20_f32;
+    let fix = |c: f32| {
+        if c.abs() < tiny {
+            if c >= 0.0 { tiny } else { -tiny }
+        } else {
+            c
+        }
+    };
+    Vec3::ONE / Vec3::new(fix(d.x), fix(d.y), fix(d.z))
+}
+
+/// Parallelogram; twin of WGSL `intersect_quad`. Returns `(t, s, t_param)`.
+pub fn intersect_quad(origin: Vec3, eu: Vec3, ev: Vec3, ray: &Ray, t_max: f32) -> (f32, f32, f32) {
+    let n = eu.cross(ev);
+    let denom = n.dot(ray.dir);
+    let nn = n.dot(n);
+    if denom.abs() <= 1e-12 * nn.sqrt() || nn <= 0.0 {
+        return (MISS, 0.0, 0.0);
+    }
+    let t = n.dot(origin - ray.origin) / denom;
+    if !(t > 0.0 && t < t_max) {
+        return (MISS, 0.0, 0.0);
+    }
+    let p = ray.origin + t * ray.dir - origin;
+    let s = p.cross(ev).dot(n) / nn;
+    let r = eu.cross(p).dot(n) / nn;
+    if !(0.0..=1.0).contains(&s) || !(0.0..=1.0).contains(&r) {
+        return (MISS, 0.0, 0.0);
+    }
+    (t, s, r)
+}
+
+/// Sphere; twin of WGSL `intersect_sphere`.
+pub fn intersect_sphere(center: Vec3, radius: f32, ray: &Ray, t_max: f32) -> f32 {
+    let oc = ray.origin - center;
+    let b = -oc.dot(ray.dir);
+    let closest = oc + b * ray.dir;
+    let disc = radius * radius - closest.dot(closest);
+    if disc < 0.0 {
+        return MISS;
+    }
+    let h = disc.sqrt();
+    let t_near = b - h;
+    if t_near > 0.0 && t_near < t_max {
+        return t_near;
+    }
+    let t_far = b + h;
+    if t_far > 0.0 && t_far < t_max {
+        return t_far;
+    }
+    MISS
+}
+
+/// Cylinder; twin of WGSL `intersect_cylinder`.
+pub fn intersect_cylinder(
+    p0: Vec3,
+    p1: Vec3,
+    radius: f32,
+    caps: bool,
+    ray: &Ray,
+    t_max: f32,
+) -> f32 {
+    let axis_full = p1 - p0;
+    let height = axis_full.length();
+    let axis = axis_full / height;
+    let oc = ray.origin - p0;
+    let d_perp = ray.dir - ray.dir.dot(axis) * axis;
+    let o_perp = oc - oc.dot(axis) * axis;
+    let mut t_best = MISS;
+    let a = d_perp.dot(d_perp);
+    if a > 1e-12 {
+        let b = d_perp.dot(o_perp);
+        let c = o_perp.dot(o_perp) - radius * radius;
+        let disc = b * b - a * c;
+        if disc >= 0.0 {
+            let h = disc.sqrt();
+            for t in [(-b - h) / a, (-b + h) / a] {
+                let y = (oc + t * ray.dir).dot(axis);
+                if t > 0.0 && t < t_max.min(t_best) && y >= 0.0 && y <= height {
+                    t_best = t;
+                }
+            }
+        }
+    }
+    if caps {
+        let d_axis = ray.dir.dot(axis);
+        if d_axis.abs() > 1e-12 {
+            for cap_height in [0.0, height] {
+                let t = (cap_height - oc.dot(axis)) / d_axis;
+                let q = o_perp + t * d_perp;
+                if t > 0.0 && t < t_max.min(t_best) && q.dot(q) <= radius * radius {
+                    t_best = t;
+                }
+            }
+        }
+    }
+    t_best
+}
+
+/// Moller-Trumbore; twin of WGSL `intersect_triangle`. Returns `(t, b1, b2)`.
+pub fn intersect_triangle(v0: Vec3, v1: Vec3, v2: Vec3, ray: &Ray, t_max: f32) -> (f32, f32, f32) {
+    let e1 = v1 - v0;
+    let e2 = v2 - v0;
+    let p = ray.dir.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() < 1e-20 {
+        return (MISS, 0.0, 0.0);
+    }
+    let inv_det = 1.0 / det;
+    let s = ray.origin - v0;
+    let b1 = s.dot(p) * inv_det;
+    if !(0.0..=1.0).contains(&b1) {
+        return (MISS, 0.0, 0.0);
+    }
+    let q = s.cross(e1);
+    let b2 = ray.dir.dot(q) * inv_det;
+    if b2 < 0.0 || b1 + b2 > 1.0 {
+        return (MISS, 0.0, 0.0);
+    }
+    let t = e2.dot(q) * inv_det;
+    if !(t > 0.0 && t < t_max) {
+        return (MISS, 0.0, 0.0);
+    }
+    (t, b1, b2)
+}
+
+/// Ordered stack traversal of the BVH rooted at `root`; `leaf` intersects one leaf's
+/// primitives and updates the hit. Twin of the loops in WGSL `intersect_mesh` and
+/// `intersect_scene`.
+fn traverse(
+    nodes: &[GpuBvhNode],
+    root: u32,
+    ray: &Ray,
+    inv_dir: Vec3,
+    hit: &mut Hit,
+    mut leaf: impl FnMut(&GpuBvhNode, &mut Hit),
+) {
+    let mut stack = [(0u32, 0.0f32); STACK_SIZE];
+    let mut sp = 0;
+    let mut index = root;
+    if intersect_aabb(&nodes[root as usize], ray.origin, inv_dir, hit.t) == MISS {
+        return;
+    }
+    loop {
+        let node = &nodes[index as usize];
+        let mut descend = false;
+        if node.prim_count > 0 {
+            leaf(node, hit);
+        } else {
+            let a = node.first_index;
+            let ta = intersect_aabb(&nodes[a as usize], ray.origin, inv_dir, hit.t);
+            let tb = intersect_aabb(&nodes[a as usize + 1], ray.origin, inv_dir, hit.t);
+            if ta != MISS && tb != MISS {
+                let (near, far) = if ta <= tb { (a, a + 1) } else { (a + 1, a) };
+                index = near;
+                if sp < STACK_SIZE {
+                    stack[sp] = (far, ta.max(tb));
+                    sp += 1;
+                }
+                descend = true;
+            } else if ta != MISS || tb != MISS {
+                index = if ta != MISS { a } else { a + 1 };
+                descend = true;
+            }
+        }
+        if !descend {
+            let mut found = false;
+            while sp > 0 {
+                sp -= 1;
+                if stack[sp].1 < hit.t {
+                    index = stack[sp].0;
+                    found = true;
+                    break;
+                }
+            }
+            if !found {
+                break;
+            }
+        }
+    }
+}
+
+impl GpuScene {
+    /// Triangle `i`'s corner positions.
+    pub fn triangle(&self, i: u32) -> [Vec3; 3] {
+        let i = 3 * i as usize;
+        [0, 1, 2].map(|k| Vec3::from(self.vertices[i + k].position))
+    }
+
+    /// Nearest hit on object `i` (top-level order), updating `hit`; twin of WGSL
+    /// `intersect_object`.
+    pub fn intersect_object(&self, i: u32, ray: &Ray, inv_dir: Vec3, hit: &mut Hit) {
+        let o = &self.objects[i as usize];
+        let a = Vec3::from_slice(&o.a);
+        let b = Vec3::from_slice(&o.b);
+        let c = Vec3::from_slice(&o.c);
+        let simple = |t: f32, b1: f32, b2: f32, hit: &mut Hit| {
+            if t < hit.t {
+                *hit = Hit {
+                    t,
+                    object: i,
+                    primitive: 0,
+                    b1,
+                    b2,
+                };
+            }
+        };
+        match o.kind {
+            KIND_QUAD => {
+                let (t, s, r) = intersect_quad(a, b, c, ray, hit.t);
+                simple(t, s, r, hit);
+            }
+            KIND_SPHERE => simple(intersect_sphere(a, o.a[3], ray, hit.t), 0.0, 0.0, hit),
+            KIND_CYLINDER => {
+                let caps = o.flags & FLAG_CAPS != 0;
+                simple(
+                    intersect_cylinder(a, b, o.a[3], caps, ray, hit.t),
+                    0.0,
+                    0.0,
+                    hit,
+                );
+            }
+            _ => traverse(&self.nodes, o.blas_root, ray, inv_dir, hit, |node, hit| {
+                for tri in node.first_index..node.first_index + node.prim_count {
+                    let [v0, v1, v2] = self.triangle(tri);
+                    let (t, b1, b2) = intersect_triangle(v0, v1, v2, ray, hit.t);
+                    if t < hit.t {
+                        *hit = Hit {
+                            t,
+                            object: i,
+                            primitive: tri,
+                            b1,
+                            b2,
+                        };
+                    }
+                }
+            }),
+        }
+    }
+
+    /// Nearest hit in `(0, t_max)`; twin of WGSL `intersect_scene`.
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let mut hit = Hit {
+            t: t_max,
+            object: u32::MAX,
+            primitive: 0,
+            b1: 0.0,
+            b2: 0.0,
+        };
+        if self.object_count == 0 {
+            return None;
+        }
+        let inv_dir = safe_inverse(ray.dir);
+        traverse(&self.nodes, 0, ray, inv_dir, &mut hit, |node, hit| {
+            for i in node.first_index..node.first_index + node.prim_count {
+                self.intersect_object(i, ray, inv_dir, hit);
+            }
+        });
+        (hit.object != u32::MAX).then_some(hit)
+    }
+}

@@ -1,0 +1,369 @@
+//! The BVH: structure validated after every build, and traversal compared with brute force
+//! on random rays, for random, empty and degenerate scenes.
+
+use glam::{Vec2, Vec3};
+use pathlight_core::gpu::{GpuBvhNode, KIND_MESH};
+use pathlight_core::scene::{Camera, RenderSettings, TriangleMesh};
+use pathlight_core::trace::{Hit, MISS, Ray, intersect_triangle, safe_inverse};
+use pathlight_core::{GpuScene, Object, Scene, Shape};
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+
+fn scene_of(objects: Vec<Object>) -> Scene {
+    Scene {
+        camera: Camera {
+            position: Vec3::Z,
+            look_at: Vec3::ZERO,
+            up: Vec3::Y,
+            fov_y_deg: 40.0,
+            width: 8,
+            height: 8,
+        },
+        settings: RenderSettings {
+            spp: 1,
+            max_depth: 8,
+            rr_depth: 5,
+            seed: 0,
+        },
+        environment: Vec3::ZERO,
+        materials: Vec::new(),
+        textures: Vec::new(),
+        objects,
+    }
+}
+
+fn random_point(rng: &mut StdRng, extent: f32) -> Vec3 {
+    Vec3::new(
+        rng.random_range(-extent..extent),
+        rng.random_range(-extent..extent),
+        rng.random_range(-extent..extent),
+    )
+}
+
+fn random_mesh(rng: &mut StdRng, triangles: usize, center: Vec3) -> TriangleMesh {
+    let mut mesh = TriangleMesh::default();
+    for t in 0..triangles {
+        let p = center + random_point(rng, 1.0);
+        for _ in 0..3 {
+            mesh.positions.push(p + random_point(rng, 0.2));
+            mesh.normals.push(Vec3::Y);
+            mesh.uvs.push(Vec2::ZERO);
+        }
+        let i = 3 * t as u32;
+        mesh.indices.push([i, i + 1, i + 2]);
+    }
+    mesh
+}
+
+fn random_objects(rng: &mut StdRng, count: usize) -> Vec<Object> {
+    (0..count)
+        .map(|i| {
+            let c = random_point(rng, 3.0);
+            let shape = match i % 4 {
+                0 => Shape::Quad {
+                    origin: c,
+                    edge_u: random_point(rng, 1.0),
+                    edge_v: random_point(rng, 1.0),
+                },
+                1 => Shape::Sphere {
+                    center: c,
+                    radius: rng.random_range(0.05..0.6),
+                    texture_rotation: 0.0,
+                },
+                2 => Shape::Cylinder {
+                    p0: c,
+                    p1: c + random_point(rng, 1.0),
+                    radius: rng.random_range(0.05..0.4),
+                    caps: rng.random_bool(0.5),
+                },
+                _ => {
+                    let triangles = rng.random_range(1..300);
+                    Shape::Mesh(random_mesh(rng, triangles, c))
+                }
+            };
+            Object {
+                name: format!("o{i}"),
+                material: 0,
+                shape,
+            }
+        })
+        .collect()
+}
+
+/// Every node's box holds its children or primitives; every primitive is in exactly one leaf.
+fn validate(gpu: &GpuScene) {
+    fn contains(outer: &GpuBvhNode, min: Vec3, max: Vec3) -> bool {
+        Vec3::from(outer.aabb_min).cmple(min + 1e-4).all()
+            && Vec3::from(outer.aabb_max).cmpge(max - 1e-4).all()
+    }
+    fn walk(
+        gpu: &GpuScene,
+        index: u32,
+        seen: &mut Vec<u32>,
+        leaf: &mut dyn FnMut(&GpuBvhNode, u32, &mut Vec<u32>),
+    ) {
+        let node = gpu.nodes[index as usize];
+        if node.prim_count == 0 {
+            for child in [node.first_index, node.first_index + 1] {
+                let c = gpu.nodes[child as usize];
+                assert!(
+                    contains(&node, c.aabb_min.into(), c.aabb_max.into()),
+                    "child {child} escapes node {index}"
+                );
+                walk(gpu, child, seen, leaf);
+            }
+        } else {
+            for p in node.first_index..node.first_index + node.prim_count {
+                leaf(&node, p, seen);
+            }
+        }
+    }
+    let mut seen_objects = Vec::new();
+    walk(gpu, 0, &mut seen_objects, &mut |_, p, seen| seen.push(p));
+    seen_objects.sort_unstable();
+    assert_eq!(seen_objects, (0..gpu.object_count).collect::<Vec<_>>());
+    for object in gpu.objects.iter().filter(|o| o.kind == KIND_MESH) {
+        let mut seen = Vec::new();
+        walk(gpu, object.blas_root, &mut seen, &mut |node, tri, seen| {
+            for v in gpu.triangle(tri) {
+                assert!(contains(node, v, v), "triangle {tri} escapes its leaf");
+            }
+            seen.push(tri);
+        });
+        seen.sort_unstable();
+        seen.dedup();
+        let count = seen.len();
+        assert_eq!(
+            seen.last().unwrap() - seen[0] + 1,
+            count as u32,
+            "BLAS leaves are not one contiguous range"
+        );
+    }
+}
+
+/// The nearest hit over every object and every triangle, without the BVH.
+fn brute_force(gpu: &GpuScene, ray: &Ray, t_max: f32) -> Option<Hit> {
+    let inv_dir = safe_inverse(ray.dir);
+    let mut hit = Hit {
+        t: t_max,
+        object: u32::MAX,
+        primitive: 0,
+        b1: 0.0,
+        b2: 0.0,
+    };
+    for (i, o) in gpu
+        .objects
+        .iter()
+        .enumerate()
+        .take(gpu.object_count as usize)
+    {
+        if o.kind == KIND_MESH {
+            continue;
+        }
+        gpu.intersect_object(i as u32, ray, inv_dir, &mut hit);
+    }
+    let mesh_objects: Vec<(u32, u32)> = gpu
+        .objects
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| o.kind == KIND_MESH)
+        .map(|(i, o)| (i as u32, o.blas_root))
+        .collect();
+    for tri in 0..(gpu.vertices.len() / 3) as u32 {
+        let [v0, v1, v2] = gpu.triangle(tri);
+        let (t, b1, b2) = intersect_triangle(v0, v1, v2, ray, hit.t);
+        if t < hit.t {
+            // Find the mesh whose BLAS range holds this triangle: the last root whose first leaf is <= tri.
+            let object = owner_of(gpu, &mesh_objects, tri);
+            hit = Hit {
+                t,
+                object,
+                primitive: tri,
+                b1,
+                b2,
+            };
+        }
+    }
+    (hit.object != u32::MAX).then_some(hit)
+}
+
+fn owner_of(gpu: &GpuScene, meshes: &[(u32, u32)], tri: u32) -> u32 {
+    fn leaves(gpu: &GpuScene, index: u32, out: &mut Vec<u32>) {
+        let n = gpu.nodes[index as usize];
+        if n.prim_count == 0 {
+            leaves(gpu, n.first_index, out);
+            leaves(gpu, n.first_index + 1, out);
+        } else {
+            out.extend(n.first_index..n.first_index + n.prim_count);
+        }
+    }
+    meshes
+        .iter()
+        .find(|(_, root)| {
+            let mut tris = Vec::new();
+            leaves(gpu, *root, &mut tris);
+            tris.contains(&tri)
+        })
+        .map(|(i, _)| *i)
+        .expect("every triangle belongs to a mesh")
+}
+
+/// A ray from anywhere in a 10-unit cube towards a point within `target` of the origin.
+fn random_ray(rng: &mut StdRng, target: f32) -> Ray {
+    let origin = random_point(rng, 5.0);
+    Ray {
+        origin,
+        dir: (random_point(rng, target) - origin).normalize_or(Vec3::X),
+    }
+}
+
+fn assert_same(gpu: &GpuScene, rays: &[Ray]) -> usize {
+    let mut hits = 0;
+    for ray in rays {
+        let fast = gpu.intersect(ray, 1e30);
+        let slow = brute_force(gpu, ray, 1e30);
+        match (fast, slow) {
+            (None, None) => {}
+            (Some(a), Some(b)) => {
+                hits += 1;
+                assert!(
+                    (a.t - b.t).abs() <= 1e-5 * b.t.max(1.0),
+                    "ray {ray:?}: bvh t {} vs brute force {}",
+                    a.t,
+                    b.t
+                );
+                if (a.t - b.t).abs() > 1e-7 * b.t {
+                    continue; // equal distances on two primitives: either answer is right
+                }
+                assert_eq!(a.object, b.object, "ray {ray:?}");
+            }
+            (a, b) => panic!("ray {ray:?}: bvh {a:?} vs brute force {b:?}"),
+        }
+    }
+    hits
+}
+
+/// A ray towards a random point of the top-level root's box.
+fn ray_into_root_box(rng: &mut StdRng, gpu: &GpuScene) -> Ray {
+    let root = gpu.nodes[0];
+    let (min, max) = (Vec3::from(root.aabb_min), Vec3::from(root.aabb_max));
+    let target = min + (max - min) * Vec3::new(rng.random(), rng.random(), rng.random());
+    let origin = random_point(rng, 5.0);
+    Ray {
+        origin,
+        dir: (target - origin).normalize_or(Vec3::X),
+    }
+}
+
+#[test]
+fn traversal_matches_brute_force_on_random_scenes() {
+    let mut rng = StdRng::seed_from_u64(7);
+    for count in [1, 2, 5, 40] {
+        let gpu = GpuScene::build(&scene_of(random_objects(&mut rng, count)));
+        validate(&gpu);
+        let rays: Vec<Ray> = (0..2000)
+            .map(|_| ray_into_root_box(&mut rng, &gpu))
+            .collect();
+        let hits = assert_same(&gpu, &rays);
+        assert!(
+            hits > 20,
+            "{count} objects: only {hits} of 2000 rays hit; the test would prove little"
+        );
+    }
+}
+
+#[test]
+fn empty_scene_has_no_hits() {
+    let gpu = GpuScene::build(&scene_of(Vec::new()));
+    assert_eq!(gpu.object_count, 0);
+    let mut rng = StdRng::seed_from_u64(1);
+    for _ in 0..100 {
+        assert_eq!(gpu.intersect(&random_ray(&mut rng, 3.0), 1e30), None);
+    }
+}
+
+#[test]
+fn degenerate_triangles_and_axis_rays() {
+    let mut mesh = TriangleMesh::default();
+    let pts = [
+        // Zero area (collinear), a repeated point, and one proper triangle.
+        [Vec3::ZERO, Vec3::X, Vec3::X * 2.0],
+        [Vec3::Y, Vec3::Y, Vec3::Z],
+        [
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        ],
+    ];
+    for (t, tri) in pts.iter().enumerate() {
+        mesh.positions.extend(tri);
+        mesh.normals.extend([Vec3::Z; 3]);
+        mesh.uvs.extend([Vec2::ZERO; 3]);
+        let i = 3 * t as u32;
+        mesh.indices.push([i, i + 1, i + 2]);
+    }
+    let objects = vec![
+        Object {
+            name: "mesh".into(),
+            material: 0,
+            shape: Shape::Mesh(mesh),
+        },
+        Object {
+            name: "flat quad".into(),
+            material: 0,
+            shape: Shape::Quad {
+                origin: Vec3::new(-1.0, -1.0, -2.0),
+                edge_u: Vec3::X * 2.0,
+                edge_v: Vec3::Y * 2.0,
+            },
+        },
+    ];
+    let gpu = GpuScene::build(&scene_of(objects));
+    validate(&gpu);
+    // Rays along the axes (zero direction components) through the flat boxes.
+    let mut rays = vec![
+        Ray {
+            origin: Vec3::new(0.0, 0.0, 5.0),
+            dir: -Vec3::Z,
+        },
+        Ray {
+            origin: Vec3::new(0.5, -0.5, 5.0),
+            dir: -Vec3::Z,
+        },
+        Ray {
+            origin: Vec3::new(5.0, 0.0, 0.0),
+            dir: -Vec3::X,
+        },
+        Ray {
+            origin: Vec3::new(0.0, 5.0, -2.0),
+            dir: -Vec3::Y,
+        },
+    ];
+    let mut rng = StdRng::seed_from_u64(3);
+    rays.extend((0..500).map(|_| random_ray(&mut rng, 1.0)));
+    assert!(assert_same(&gpu, &rays) >= 2);
+    let hit = gpu
+        .intersect(&rays[0], 1e30)
+        .expect("the proper triangle is hit");
+    assert!((hit.t - 5.0).abs() < 1e-5);
+    assert_eq!(
+        gpu.intersect(&rays[0], 4.0),
+        None,
+        "t_max must bound the search"
+    );
+    assert!(MISS > 1e30);
+}
+
+#[test]
+fn large_mesh_bvh_is_valid_and_exact() {
+    let mut rng = StdRng::seed_from_u64(11);
+    let objects = vec![Object {
+        name: "big".into(),
+        material: 0,
+        shape: Shape::Mesh(random_mesh(&mut rng, 20_000, Vec3::ZERO)),
+    }];
+    let gpu = GpuScene::build(&scene_of(objects));
+    validate(&gpu);
+    let rays: Vec<Ray> = (0..300).map(|_| random_ray(&mut rng, 1.0)).collect();
+    assert!(assert_same(&gpu, &rays) > 50);
+}

@@ -1,0 +1,140 @@
+// Ray-primitive intersection: boxes, quads, spheres, cylinders, triangles.
+// CPU twin: `crates/core/src/trace.rs` (same names, same arithmetic).
+// Each function returns the hit distance, or MISS when there is none in (0, t_max).
+
+const MISS: f32 = 3.0e38;
+
+struct Ray {
+    origin: vec3f,
+    dir: vec3f,
+}
+
+// Slab test; `inv_dir` has no infinities (see `safe_inverse`). Returns the entry distance.
+fn intersect_aabb(node: BvhNode, origin: vec3f, inv_dir: vec3f, t_max: f32) -> f32 {
+    let t0 = (node.aabb_min - origin) * inv_dir;
+    let t1 = (node.aabb_max - origin) * inv_dir;
+    let t_near = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
+    let t_far = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), min(max(t0.z, t1.z), t_max));
+    return select(MISS, t_near, t_near <= t_far);
+}
+
+// 1 / d with zero components replaced by a tiny value of the same sign.
+fn safe_inverse(d: vec3f) -> vec3f {
+    let tiny = 1e-20;
+    let x = select(d.x, select(-tiny, tiny, d.x >= 0.0), abs(d.x) < tiny);
+    let y = select(d.y, select(-tiny, tiny, d.y >= 0.0), abs(d.y) < tiny);
+    let z = select(d.z, select(-tiny, tiny, d.z >= 0.0), abs(d.z) < tiny);
+    return 1.0 / vec3f(x, y, z);
+}
+
+// Parallelogram origin + s eu + t ev; returns (t, s, t_param).
+fn intersect_quad(origin: vec3f, eu: vec3f, ev: vec3f, ray: Ray, t_max: f32) -> vec3f {
+    let n = cross(eu, ev);
+    let denom = dot(n, ray.dir);
+    let nn = dot(n, n);
+    if abs(denom) <= 1e-12 * sqrt(nn) || nn <= 0.0 {
+        return vec3f(MISS, 0.0, 0.0);
+    }
+    let t = dot(n, origin - ray.origin) / denom;
+    if !(t > 0.0 && t < t_max) {
+        return vec3f(MISS, 0.0, 0.0);
+    }
+    let p = ray.origin + t * ray.dir - origin;
+    let s = dot(cross(p, ev), n) / nn;
+    let r = dot(cross(eu, p), n) / nn;
+    if s < 0.0 || s > 1.0 || r < 0.0 || r > 1.0 {
+        return vec3f(MISS, 0.0, 0.0);
+    }
+    return vec3f(t, s, r);
+}
+
+// Sphere; `ray.dir` is unit. The discriminant uses the closest-approach form
+// (Haines et al., Ray Tracing Gems ch. 7) to stay accurate far from the sphere.
+fn intersect_sphere(center: vec3f, radius: f32, ray: Ray, t_max: f32) -> f32 {
+    let oc = ray.origin - center;
+    let b = -dot(oc, ray.dir);
+    let closest = oc + b * ray.dir;
+    let disc = radius * radius - dot(closest, closest);
+    if disc < 0.0 {
+        return MISS;
+    }
+    let h = sqrt(disc);
+    let t_near = b - h;
+    if t_near > 0.0 && t_near < t_max {
+        return t_near;
+    }
+    let t_far = b + h;
+    if t_far > 0.0 && t_far < t_max {
+        return t_far;
+    }
+    return MISS;
+}
+
+// Cylinder from p0 to p1 (side, and the end disks when `caps`).
+fn intersect_cylinder(p0: vec3f, p1: vec3f, radius: f32, caps: bool, ray: Ray, t_max: f32) -> f32 {
+    let axis_full = p1 - p0;
+    let height = length(axis_full);
+    let axis = axis_full / height;
+    let oc = ray.origin - p0;
+    let d_perp = ray.dir - dot(ray.dir, axis) * axis;
+    let o_perp = oc - dot(oc, axis) * axis;
+    var t_best = MISS;
+    let a = dot(d_perp, d_perp);
+    if a > 1e-12 {
+        let b = dot(d_perp, o_perp);
+        let c = dot(o_perp, o_perp) - radius * radius;
+        let disc = b * b - a * c;
+        if disc >= 0.0 {
+            let h = sqrt(disc);
+            let roots = array<f32, 2>((-b - h) / a, (-b + h) / a);
+            for (var i = 0; i < 2; i++) {
+                let t = roots[i];
+                let y = dot(oc + t * ray.dir, axis);
+                if t > 0.0 && t < min(t_max, t_best) && y >= 0.0 && y <= height {
+                    t_best = t;
+                }
+            }
+        }
+    }
+    if caps {
+        let d_axis = dot(ray.dir, axis);
+        if abs(d_axis) > 1e-12 {
+            let heights = array<f32, 2>(0.0, height);
+            for (var i = 0; i < 2; i++) {
+                let t = (heights[i] - dot(oc, axis)) / d_axis;
+                let q = o_perp + t * d_perp;
+                if t > 0.0 && t < min(t_max, t_best) && dot(q, q) <= radius * radius {
+                    t_best = t;
+                }
+            }
+        }
+    }
+    return t_best;
+}
+
+// Moller-Trumbore; returns (t, b1, b2) with barycentrics of vertices 1 and 2.
+fn intersect_triangle(v0: vec3f, v1: vec3f, v2: vec3f, ray: Ray, t_max: f32) -> vec3f {
+    let e1 = v1 - v0;
+    let e2 = v2 - v0;
+    let p = cross(ray.dir, e2);
+    let det = dot(e1, p);
+    if abs(det) < 1e-20 {
+        return vec3f(MISS, 0.0, 0.0);
+    }
+    let inv_det = 1.0 / det;
+    let s = ray.origin - v0;
+    let b1 = dot(s, p) * inv_det;
+    if b1 < 0.0 || b1 > 1.0 {
+        return vec3f(MISS, 0.0, 0.0);
+    }
+    let q = cross(s, e1);
+    let b2 = dot(ray.dir, q) * inv_det;
+    if b2 < 0.0 || b1 + b2 > 1.0 {
+        return vec3f(MISS, 0.0, 0.0);
+    }
+    let t = dot(e2, q) * inv_det;
+    if !(t > 0.0 && t < t_max) {
+        return vec3f(MISS, 0.0, 0.0);
+    }
+    return vec3f(t, b1, b2);
+}

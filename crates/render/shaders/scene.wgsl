@@ -1,0 +1,81 @@
+// Scene data shared by every pass: struct declarations (mirrored on the host by
+// `crates/core/src/gpu.rs`, pinned by `crates/render/tests/layout.rs`) and the bind group 0
+// buffers that `GpuScene` fills.
+
+const KIND_QUAD: u32 = 0u;
+const KIND_SPHERE: u32 = 1u;
+const KIND_CYLINDER: u32 = 2u;
+const KIND_MESH: u32 = 3u;
+const FLAG_FLAT: u32 = 1u;
+const FLAG_CAPS: u32 = 2u;
+
+// One object, a leaf of the top-level BVH. Host: `GpuObject`.
+struct Object {
+    a: vec4f,
+    b: vec4f,
+    c: vec4f,
+    kind: u32,
+    material: u32,
+    blas_root: u32,
+    id: u32,
+    flags: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
+
+// obvhs' Bvh2Node: prim_count 0 = inner node (children first_index, first_index + 1),
+// else a leaf of primitives first_index .. first_index + prim_count. Host: `GpuBvhNode`.
+struct BvhNode {
+    aabb_min: vec3f,
+    pad0: u32,
+    aabb_max: vec3f,
+    pad1: u32,
+    prim_count: u32,
+    first_index: u32,
+    pad2: u32,
+    pad3: u32,
+}
+
+// A triangle corner; triangle i is vertices 3i, 3i+1, 3i+2. Host: `GpuVertex`.
+struct Vertex {
+    position: vec3f,
+    u: f32,
+    normal: vec3f,
+    v: f32,
+}
+
+// Linear-RGB material with the seed's lobe weights. Host: `GpuMaterial`.
+struct Material {
+    base_color: vec3f,
+    texture: i32,
+    emission: vec3f,
+    specular_rate: f32,
+    eta: vec3f,
+    specular_tint: f32,
+    k: vec3f,
+    specular_roughness: f32,
+    refract_rate: f32,
+    refract_tint: f32,
+    ior: f32,
+    refract_roughness: f32,
+    conductor: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
+
+// Where a texture lies in `texels`. Host: `GpuTextureInfo`.
+struct TextureInfo {
+    offset: u32,
+    width: u32,
+    height: u32,
+    pad: u32,
+}
+
+@group(0) @binding(0) var<storage, read> nodes: array<BvhNode>;
+@group(0) @binding(1) var<storage, read> objects: array<Object>;
+@group(0) @binding(2) var<storage, read> vertices: array<Vertex>;
+@group(0) @binding(3) var<storage, read> materials: array<Material>;
+@group(0) @binding(4) var<storage, read> textures: array<TextureInfo>;
+@group(0) @binding(5) var<storage, read> texels: array<u32>;

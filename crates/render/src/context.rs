@@ -1,0 +1,124 @@
+//! Choosing an adapter and opening a device on it.
+//!
+//! Preference: a hardware GPU (discrete, then integrated, then virtual), then Mesa's
+//! software adapters (lavapipe on Vulkan, llvmpipe on GL); within a kind, Vulkan, Metal and
+//! DX12 before GL. `WGPU_BACKEND` restricts the backends, a name restricts the adapters.
+
+use wgpu::{Adapter, AdapterInfo, Backend, DeviceType};
+
+use crate::error::RenderError;
+
+/// An open device with its queue and the adapter it runs on.
+#[derive(Debug)]
+pub struct GpuContext {
+    /// The device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    /// The adapter's description.
+    pub adapter_info: AdapterInfo,
+}
+
+/// How hardware-like an adapter is; lower is preferred.
+fn rank(info: &AdapterInfo) -> (u8, u8) {
+    let kind = match info.device_type {
+        DeviceType::DiscreteGpu => 0,
+        DeviceType::IntegratedGpu => 1,
+        DeviceType::VirtualGpu => 2,
+        DeviceType::Cpu => 3,
+        DeviceType::Other => 4,
+    };
+    let backend = match info.backend {
+        Backend::Vulkan | Backend::Metal | Backend::Dx12 => 0,
+        _ => 1,
+    };
+    (kind, backend)
+}
+
+/// One line naming an adapter, as printed by the CLI.
+pub fn describe(info: &AdapterInfo) -> String {
+    format!(
+        "{} ({:?}, {:?}, driver {} {})",
+        info.name, info.backend, info.device_type, info.driver, info.driver_info
+    )
+}
+
+/// The adapters on the backends named by `WGPU_BACKEND`; without it, those on the native
+/// backends (Vulkan, Metal, DX12), or the GL ones when there are none.
+pub fn available_adapters() -> Vec<Adapter> {
+    if let Some(backends) = wgpu::Backends::from_env() {
+        return adapters_on(backends);
+    }
+    let native = adapters_on(wgpu::Backends::PRIMARY);
+    if !native.is_empty() {
+        return native;
+    }
+    adapters_on(wgpu::Backends::GL)
+}
+
+/// Adapters on `backends`, from an instance that initialises only those backends.
+fn adapters_on(backends: wgpu::Backends) -> Vec<Adapter> {
+    let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+    descriptor.backends = backends;
+    let instance = wgpu::Instance::new(descriptor);
+    pollster::block_on(instance.enumerate_adapters(backends))
+}
+
+impl GpuContext {
+    /// Opens the preferred adapter, or the best one whose name contains `name` (any case).
+    pub fn new(name: Option<&str>) -> Result<Self, RenderError> {
+        let adapters = available_adapters();
+        let names: Vec<String> = adapters.iter().map(|a| describe(&a.get_info())).collect();
+        let wanted = name.map(str::to_lowercase);
+        let adapter = adapters
+            .into_iter()
+            .filter(|a| {
+                let info = a.get_info();
+                wanted.as_ref().is_none_or(|w| {
+                    info.name.to_lowercase().contains(w)
+                        || format!("{:?}", info.backend).to_lowercase() == *w
+                })
+            })
+            .min_by_key(|a| rank(&a.get_info()))
+            .ok_or_else(|| match name {
+                Some(name) => RenderError::NoAdapter(format!(
+                    "no adapter matches {name:?}; found: {}",
+                    if names.is_empty() {
+                        "none".to_string()
+                    } else {
+                        names.join("; ")
+                    }
+                )),
+                None => RenderError::NoAdapter(
+                    "no GPU adapter found. Install a Vulkan driver; without a GPU, Mesa's \
+                     software one works: `apt-get install mesa-vulkan-drivers` (lavapipe), or \
+                     a GL driver (`libgl1-mesa-dri`, llvmpipe)"
+                        .into(),
+                ),
+            })?;
+        Self::from_adapter(&adapter)
+    }
+
+    /// Opens a device on `adapter` with the adapter's own limits (more storage buffers and
+    /// larger bindings than wgpu's defaults).
+    pub fn from_adapter(adapter: &Adapter) -> Result<Self, RenderError> {
+        let adapter_info = adapter.get_info();
+        let descriptor = wgpu::DeviceDescriptor {
+            label: Some("pathlight device"),
+            required_limits: adapter.limits(),
+            ..Default::default()
+        };
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&descriptor)).map_err(|err| {
+                RenderError::Device {
+                    adapter: adapter_info.name.clone(),
+                    message: err.to_string(),
+                }
+            })?;
+        Ok(Self {
+            device,
+            queue,
+            adapter_info,
+        })
+    }
+}

@@ -1,0 +1,31 @@
+//! Errors of the GPU side.
+
+/// What can fail between choosing an adapter and reading the image back.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// No adapter at all, or none matching the requested name.
+    #[error("{0}")]
+    NoAdapter(String),
+    /// The adapter refused to create a device.
+    #[error("cannot open a device on {adapter}: {message}")]
+    Device {
+        /// The adapter's name.
+        adapter: String,
+        /// What wgpu said.
+        message: String,
+    },
+    /// A shader or pipeline failed validation.
+    #[error("pipeline {label}: {message}")]
+    Pipeline {
+        /// The pipeline's label.
+        label: String,
+        /// What wgpu said.
+        message: String,
+    },
+    /// The scene or image does not fit the device's limits.
+    #[error("{0}")]
+    Limits(String),
+    /// The GPU failed while rendering or reading back.
+    #[error("GPU failure: {0}")]
+    Gpu(String),
+}

@@ -1,0 +1,13 @@
+//! pathlight's GPU side: adapter choice, the WGSL integrator and the progressive film.
+
+pub mod context;
+pub mod error;
+pub mod film;
+pub mod renderer;
+pub mod scene_buffers;
+pub mod shaders;
+
+pub use context::GpuContext;
+pub use error::RenderError;
+pub use film::Film;
+pub use renderer::ProgressiveRenderer;

@@ -1,0 +1,116 @@
+//! The scene on the device: the buffers of a [`GpuScene`] as bind group 0.
+
+use pathlight_core::GpuScene;
+use wgpu::util::DeviceExt;
+
+use crate::error::RenderError;
+
+/// Bind group 0 of every ray-casting pass (see `shaders/scene.wgsl`).
+#[derive(Debug)]
+pub struct SceneBuffers {
+    /// Its layout.
+    pub layout: wgpu::BindGroupLayout,
+    /// The bound buffers.
+    pub bind_group: wgpu::BindGroup,
+}
+
+/// A read-only storage buffer entry at `binding` for compute.
+pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl SceneBuffers {
+    /// Uploads `scene`, refusing buffers over the device's binding limit.
+    pub fn upload(device: &wgpu::Device, scene: &GpuScene) -> Result<Self, RenderError> {
+        let contents: [(&str, &[u8]); 6] = [
+            ("bvh nodes", bytemuck::cast_slice(&scene.nodes)),
+            ("objects", bytemuck::cast_slice(&scene.objects)),
+            ("vertices", bytemuck::cast_slice(&scene.vertices)),
+            ("materials", bytemuck::cast_slice(&scene.materials)),
+            ("texture table", bytemuck::cast_slice(&scene.textures)),
+            ("texels", bytemuck::cast_slice(&scene.texels)),
+        ];
+        let limit = device.limits().max_storage_buffer_binding_size;
+        let mut buffers = Vec::new();
+        for (label, bytes) in contents {
+            if bytes.len() as u64 > limit {
+                return Err(RenderError::Limits(format!(
+                    "the scene's {label} take {} MiB; this device binds at most {} MiB",
+                    bytes.len() >> 20,
+                    limit >> 20
+                )));
+            }
+            buffers.push(
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: bytes,
+                    usage: wgpu::BufferUsages::STORAGE,
+                }),
+            );
+        }
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene layout"),
+            entries: &(0..6).map(|i| storage_entry(i, true)).collect::<Vec<_>>(),
+        });
+        let entries: Vec<_> = buffers
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout: &layout,
+            entries: &entries,
+        });
+        Ok(Self { layout, bind_group })
+    }
+}
+
+/// Creates a compute pipeline inside an error scope so a shader mismatch is an error.
+pub fn create_compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    source: &str,
+    entry_point: &str,
+    layouts: &[&wgpu::BindGroupLayout],
+) -> Result<wgpu::ComputePipeline, RenderError> {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let layout_refs: Vec<Option<&wgpu::BindGroupLayout>> =
+        layouts.iter().map(|l| Some(*l)).collect();
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &layout_refs,
+        immediate_size: 0,
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pipeline_layout),
+        module: &module,
+        entry_point: Some(entry_point),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    match pollster::block_on(scope.pop()) {
+        None => Ok(pipeline),
+        Some(err) => Err(RenderError::Pipeline {
+            label: label.into(),
+            message: err.to_string(),
+        }),
+    }
+}

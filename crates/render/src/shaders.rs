@@ -1,0 +1,44 @@
+//! WGSL sources, assembled from the files under `shaders/` by concatenation (WGSL allows
+//! module-scope declarations in any order).
+
+/// Struct declarations and the scene bind group (group 0).
+pub const SCENE: &str = include_str!("../shaders/scene.wgsl");
+/// Ray-primitive intersection.
+pub const INTERSECT: &str = include_str!("../shaders/intersect.wgsl");
+/// Two-level BVH traversal.
+pub const BVH: &str = include_str!("../shaders/bvh.wgsl");
+/// Hash-based random numbers.
+pub const RNG: &str = include_str!("../shaders/rng.wgsl");
+/// Direction sampling and frames.
+pub const SAMPLING: &str = include_str!("../shaders/sampling.wgsl");
+/// Surface shading data from a hit.
+pub const SURFACE: &str = include_str!("../shaders/surface.wgsl");
+/// The material model.
+pub const BSDF: &str = include_str!("../shaders/bsdf.wgsl");
+/// The path-tracing pass (entry point `render`).
+pub const INTEGRATOR: &str = include_str!("../shaders/integrator.wgsl");
+
+/// Every shader file with its name, for validation.
+pub const FILES: [(&str, &str); 8] = [
+    ("scene.wgsl", SCENE),
+    ("intersect.wgsl", INTERSECT),
+    ("bvh.wgsl", BVH),
+    ("rng.wgsl", RNG),
+    ("sampling.wgsl", SAMPLING),
+    ("surface.wgsl", SURFACE),
+    ("bsdf.wgsl", BSDF),
+    ("integrator.wgsl", INTEGRATOR),
+];
+
+/// Scene declarations, intersection and traversal: what any ray-casting pass needs.
+pub fn ray_query_library() -> String {
+    [SCENE, INTERSECT, BVH].concat()
+}
+
+/// The full integrator module.
+pub fn integrator_module() -> String {
+    [
+        SCENE, INTERSECT, BVH, RNG, SAMPLING, SURFACE, BSDF, INTEGRATOR,
+    ]
+    .concat()
+}
