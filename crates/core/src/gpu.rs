@@ -174,15 +174,24 @@ pub struct GpuFrameParams {
 }
 const _: () = assert!(size_of::<GpuFrameParams>() == 96);
 
-/// One pixel of the accumulation buffer: a Kahan-compensated sum. WGSL: `AccumPixel`.
+/// One pixel of the accumulation buffer. WGSL: `AccumPixel`.
 ///
-/// The running sum of all samples is `sum - compensation`; `sum.w` is unused.
+/// Per RGB channel the running sum of samples is the 64-bit fixed-point number
+/// `hi + lo / 2^32`, added with integer carries on the GPU, so it is exact and merges
+/// exactly; the fourth lane is unused.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuAccumPixel {
-    /// Running sum of sample radiance.
-    pub sum: [f32; 4],
-    /// Kahan compensation: the low-order part lost from `sum` (negated).
-    pub compensation: [f32; 4],
+    /// Integer part of the sum.
+    pub hi: [u32; 4],
+    /// Fraction of the sum, in units of 2^-32.
+    pub lo: [u32; 4],
+}
+
+impl GpuAccumPixel {
+    /// The sum of channel `c` as a float.
+    pub fn channel_sum(&self, c: usize) -> f64 {
+        f64::from(self.hi[c]) + f64::from(self.lo[c]) / 4_294_967_296.0
+    }
 }
 const _: () = assert!(size_of::<GpuAccumPixel>() == 32);

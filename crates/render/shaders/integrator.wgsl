@@ -1,5 +1,5 @@
 // The progressive path-tracing pass. One invocation per pixel of a band of rows adds
-// `batch_samples` jittered (box-filtered) samples to a Kahan-compensated accumulation
+// `batch_samples` jittered (box-filtered) samples to an exact fixed-point accumulation
 // buffer. Paths are unidirectional with BSDF sampling, `max_depth` counted in segments as
 // Mitsuba counts it, and Russian roulette from `rr_depth`. Non-finite samples are dropped
 // (counted as zero) so no NaN or Inf reaches the film.
@@ -22,10 +22,37 @@ struct FrameParams {
     row_offset: u32,
 }
 
-// Kahan-compensated running sum: the true sum is `sum - compensation`. Host: `GpuAccumPixel`.
+// Running sum of samples per channel as a 64-bit fixed-point number hi + lo / 2^32.
+// Integer adds are exact and cannot be reassociated by a shader compiler (a Kahan sum
+// was: Mesa folds its compensation away), so the mean is exact to 2^-32 per sample
+// however many samples and batches there are, and partial sums merge exactly.
+// Host: `GpuAccumPixel`.
 struct AccumPixel {
-    sum: vec4f,
-    compensation: vec4f,
+    hi: vec4u,
+    lo: vec4u,
+}
+
+// Largest radiance a single sample may add per channel (2^24); larger values are clamped.
+const SAMPLE_MAX: f32 = 16777216.0;
+
+// `acc += value` in fixed point; `value` is clamped to [0, SAMPLE_MAX].
+fn add_sample(acc: ptr<function, AccumPixel>, value: vec3f) {
+    let v = clamp(value, vec3f(0.0), vec3f(SAMPLE_MAX));
+    let whole = floor(v);
+    let hi = vec3u(whole);
+    // frac * 2^32 is exact: frac has 24 significant bits and the scale is a power of two.
+    let lo = vec3u((v - whole) * 4294967296.0);
+    add_fixed(acc, AccumPixel(vec4u(hi, 0u), vec4u(lo, 0u)));
+}
+
+// `acc += x` on 64-bit fixed point, saturating instead of wrapping.
+fn add_fixed(acc: ptr<function, AccumPixel>, x: AccumPixel) {
+    let lo = (*acc).lo + x.lo;
+    let carry = select(vec4u(0u), vec4u(1u), lo < x.lo);
+    let hi = (*acc).hi + x.hi + carry;
+    let overflow = hi < (*acc).hi | (hi == (*acc).hi & (x.hi + carry) != vec4u(0u));
+    (*acc).hi = select(hi, vec4u(0xffffffffu), overflow);
+    (*acc).lo = select(lo, vec4u(0xffffffffu), overflow);
 }
 
 @group(1) @binding(0) var<uniform> params: FrameParams;
@@ -102,18 +129,15 @@ fn render(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let pixel = y * params.width + x;
-    var batch_sum = vec3f(0.0);
+    var batch = AccumPixel(vec4u(0u), vec4u(0u));
     for (var i = 0u; i < params.batch_samples; i++) {
         var rng = rng_init(pixel, params.sample_offset + i, params.seed);
         let radiance = trace_path(camera_ray(x, y, &rng), &rng);
         if is_finite3(radiance) {
-            batch_sum += radiance;
+            add_sample(&batch, radiance);
         }
     }
-    var a = accum[pixel];
-    let corrected = batch_sum - a.compensation.xyz;
-    let total = a.sum.xyz + corrected;
-    a.compensation = vec4f((total - a.sum.xyz) - corrected, 0.0);
-    a.sum = vec4f(total, 0.0);
-    accum[pixel] = a;
+    var total = accum[pixel];
+    add_fixed(&total, batch);
+    accum[pixel] = total;
 }

@@ -261,7 +261,7 @@ impl<'a> ProgressiveRenderer<'a> {
             .iter()
             .map(|a| {
                 [0, 1, 2].map(|c| {
-                    let v = ((f64::from(a.sum[c]) - f64::from(a.compensation[c])) * scale) as f32;
+                    let v = (a.channel_sum(c) * scale) as f32;
                     if v.is_finite() { v } else { 0.0 }
                 })
             })
