@@ -8,9 +8,12 @@ use common::{context, read_exr, render, repo, scene};
 use glam::Vec3;
 use pathlight_core::default_scene;
 
+/// Pixel coordinates `(x, y)`.
+type Pixels = Vec<(u32, u32)>;
+
 /// Pixels farther than `margin` pixels from the sphere's silhouette, split into
 /// (inside, outside). The furnace camera sits at distance 3.4 with a 40 degree vertical fov.
-fn furnace_regions(size: u32, radius: f32, margin: f32) -> (Vec<(u32, u32)>, Vec<(u32, u32)>) {
+fn furnace_regions(size: u32, radius: f32, margin: f32) -> (Pixels, Pixels) {
     let distance = 3.4f32;
     let tan_half = (20.0f32).to_radians().tan();
     // Angular radius of the sphere's silhouette, projected to the image plane in pixels.

@@ -1,0 +1,188 @@
+//! The `pathlight` binary end to end: the furnace command, PNG and EXR output, and
+//! every class of bad input failing with a clear message and a non-zero status.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn pathlight(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pathlight"))
+        .args(args)
+        .current_dir(repo())
+        .output()
+        .expect("the binary runs")
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+fn fails_with(args: &[&str], needles: &[&str]) -> String {
+    let output = pathlight(args);
+    let err = stderr(&output);
+    assert!(!output.status.success(), "{args:?} succeeded:\n{err}");
+    assert_eq!(
+        output.status.code(),
+        Some(1),
+        "{args:?}: a panic or signal?\n{err}"
+    );
+    for needle in needles {
+        assert!(err.contains(needle), "{args:?}: {needle:?} not in:\n{err}");
+    }
+    err
+}
+
+fn read_exr(path: &Path) -> (usize, Vec<[f32; 3]>) {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |resolution, _| {
+            (
+                resolution.width(),
+                vec![[0.0f32; 3]; resolution.width() * resolution.height()],
+            )
+        },
+        |(width, pixels), position, (r, g, b, _a): (f32, f32, f32, f32)| {
+            pixels[position.y() * *width + position.x()] = [r, g, b];
+        },
+    )
+    .unwrap();
+    (
+        image.layer_data.size.width(),
+        image.layer_data.channel_data.pixels.1,
+    )
+}
+
+/// The acceptance command: centre pixels 0.8 +- 0.01, background 1.0 +- 0.005.
+#[test]
+fn furnace_exr_reads_albedo_and_background() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("f.exr");
+    let output = pathlight(&[
+        "render",
+        "scenes/refs/furnace-0.8.toml",
+        "--spp",
+        "64",
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let err = stderr(&output);
+    assert!(output.status.success(), "{err}");
+    assert!(err.contains("adapter: "), "the adapter is printed:\n{err}");
+    let (width, pixels) = read_exr(&out);
+    assert_eq!((width, pixels.len()), (64, 64 * 64));
+    for y in 28..36 {
+        for x in 28..36 {
+            for c in pixels[y * 64 + x] {
+                assert!((c - 0.8).abs() <= 0.01, "centre pixel ({x}, {y}) = {c}");
+            }
+        }
+    }
+    for (x, y) in [(0, 0), (63, 0), (0, 63), (63, 63), (2, 32), (61, 32)] {
+        for c in pixels[y * 64 + x] {
+            assert!(
+                (c - 1.0).abs() <= 0.005,
+                "background pixel ({x}, {y}) = {c}"
+            );
+        }
+    }
+}
+
+#[test]
+fn png_output_of_the_default_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("seed.png");
+    let output = pathlight(&[
+        "render",
+        "--spp",
+        "2",
+        "--width",
+        "40",
+        "--height",
+        "30",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let decoder = std::fs::read(&out).unwrap();
+    assert_eq!(&decoder[1..4], b"PNG");
+    // IHDR: width and height, big-endian, at bytes 16..24.
+    assert_eq!(u32::from_be_bytes(decoder[16..20].try_into().unwrap()), 40);
+    assert_eq!(u32::from_be_bytes(decoder[20..24].try_into().unwrap()), 30);
+}
+
+#[test]
+fn missing_and_malformed_scene_files() {
+    fails_with(&["render", "no/such/scene.toml"], &["no/such/scene.toml"]);
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(
+        &bad,
+        "[camera]\nposition = [0, 0, 3]\nlook_at = [0, 0, 0]\nfov_y = 40\nzoom = 2\n",
+    )
+    .unwrap();
+    fails_with(&["render", bad.to_str().unwrap()], &["bad.toml:5:", "zoom"]);
+}
+
+#[test]
+fn absurd_sizes_are_refused_with_the_limit() {
+    fails_with(&["render", "--width", "0"], &["1..=8192"]);
+    fails_with(&["render", "--height", "100000"], &["1..=8192"]);
+    fails_with(&["render", "--spp", "0"], &["spp = 0", "1..=1048576"]);
+    fails_with(&["render", "--max-depth", "0"], &["max_depth = 0"]);
+}
+
+#[test]
+fn bad_outputs_are_refused_before_rendering() {
+    let err = fails_with(
+        &["render", "-o", "/no/such/dir/out.png"],
+        &["/no/such/dir/out.png", "not writable"],
+    );
+    assert!(!err.contains("adapter:"), "rendering started:\n{err}");
+    let err = fails_with(&["render", "-o", "out.jpg"], &["out.jpg", ".png or .exr"]);
+    assert!(!err.contains("adapter:"), "rendering started:\n{err}");
+}
+
+#[test]
+fn adapter_choice_errors_are_clear() {
+    fails_with(
+        &["render", "--spp", "1", "--adapter", "no-such-gpu"],
+        &["no adapter matches \"no-such-gpu\"", "found:"],
+    );
+    // DX12 does not exist on Linux: the same as a machine without any adapter.
+    let output = Command::new(env!("CARGO_BIN_EXE_pathlight"))
+        .args([
+            "render",
+            "--spp",
+            "1",
+            "-o",
+            "/tmp/pathlight-no-adapter.png",
+        ])
+        .env("WGPU_BACKEND", "dx12")
+        .output()
+        .unwrap();
+    assert_eq!(output.status.code(), Some(1));
+    let err = stderr(&output);
+    assert!(
+        err.contains("no GPU adapter found") && err.contains("mesa-vulkan-drivers"),
+        "{err}"
+    );
+    assert!(
+        !Path::new("/tmp/pathlight-no-adapter.png").exists(),
+        "a failed render leaves no empty file"
+    );
+}
+
+#[test]
+fn list_adapters_names_one() {
+    let output = pathlight(&["render", "--list-adapters"]);
+    assert!(output.status.success());
+    assert!(!String::from_utf8_lossy(&output.stdout).trim().is_empty());
+}

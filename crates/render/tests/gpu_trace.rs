@@ -1,0 +1,198 @@
+//! The WGSL traversal (`intersect.wgsl`, `bvh.wgsl`) against its CPU twin on random rays
+//! through the default scene (quads, spheres, capped cylinders and a 6k-triangle mesh). The
+//! twin itself is checked against brute force in `crates/core/tests/bvh.rs`.
+
+mod common;
+
+use common::context;
+use glam::Vec3;
+use pathlight_core::gpu::KIND_MESH;
+use pathlight_core::trace::Ray;
+use pathlight_core::{GpuScene, default_scene};
+use pathlight_render::scene_buffers::{SceneBuffers, create_compute_pipeline, storage_entry};
+use pathlight_render::shaders;
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+use wgpu::util::DeviceExt;
+
+/// A test-only pass: one ray per invocation, nearest hit written back.
+const KERNEL: &str = r#"
+struct TraceRay { origin: vec3f, t_max: f32, dir: vec3f, pad: f32 }
+struct TraceHit { t: f32, object: u32, primitive: u32, pad: u32 }
+@group(1) @binding(0) var<storage, read> rays: array<TraceRay>;
+@group(1) @binding(1) var<storage, read_write> hits: array<TraceHit>;
+
+@compute @workgroup_size(64)
+fn trace(@builtin(global_invocation_id) gid: vec3u) {
+    let i = gid.x;
+    if i >= arrayLength(&rays) {
+        return;
+    }
+    let r = rays[i];
+    let hit = intersect_scene(Ray(r.origin, r.dir), r.t_max, OBJECT_COUNT);
+    hits[i] = TraceHit(hit.t, hit.object, hit.primitive, 0u);
+}
+"#;
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct TraceRay {
+    origin: [f32; 3],
+    t_max: f32,
+    dir: [f32; 3],
+    pad: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct TraceHit {
+    t: f32,
+    object: u32,
+    primitive: u32,
+    pad: u32,
+}
+
+fn trace_on_gpu(gpu_scene: &GpuScene, rays: &[TraceRay]) -> Vec<TraceHit> {
+    let ctx = context();
+    let device = &ctx.device;
+    let scene = SceneBuffers::upload(device, gpu_scene).unwrap();
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("trace test"),
+        entries: &[storage_entry(0, true), storage_entry(1, false)],
+    });
+    let source = format!(
+        "const OBJECT_COUNT: u32 = {}u;\n{}{}",
+        gpu_scene.object_count,
+        shaders::ray_query_library(),
+        KERNEL
+    );
+    let pipeline = create_compute_pipeline(
+        device,
+        "trace test",
+        &source,
+        "trace",
+        &[&scene.layout, &layout],
+    )
+    .unwrap();
+    let ray_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("rays"),
+        contents: bytemuck::cast_slice(rays),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let size = (rays.len() * size_of::<TraceHit>()) as u64;
+    let hit_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("hits"),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let readback = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("hits readback"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("trace test"),
+        layout: &layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: ray_buffer.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: hit_buffer.as_entire_binding(),
+            },
+        ],
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &scene.bind_group, &[]);
+        pass.set_bind_group(1, &bind_group, &[]);
+        pass.dispatch_workgroups((rays.len() as u32).div_ceil(64), 1, 1);
+    }
+    encoder.copy_buffer_to_buffer(&hit_buffer, 0, &readback, 0, size);
+    ctx.queue.submit([encoder.finish()]);
+    readback
+        .slice(..)
+        .map_async(wgpu::MapMode::Read, |r| r.unwrap());
+    device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+    let view = readback.slice(..).get_mapped_range().unwrap();
+    bytemuck::cast_slice(&view).to_vec()
+}
+
+#[test]
+fn wgsl_traversal_matches_cpu_twin() {
+    let scene = default_scene::load().unwrap();
+    let gpu_scene = GpuScene::build(&scene);
+    let mut rng = StdRng::seed_from_u64(5);
+    let rays: Vec<TraceRay> = (0..20_000)
+        .map(|i| {
+            // Origins inside the room and in front of it; directions uniform on the sphere;
+            // every tenth ray with a short t_max.
+            let origin = Vec3::new(
+                rng.random_range(-1.9..1.9),
+                rng.random_range(0.01..2.3),
+                rng.random_range(-2.9..2.0),
+            );
+            let dir = loop {
+                let d = Vec3::new(
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                );
+                if (0.01..1.0).contains(&d.length_squared()) {
+                    break d.normalize();
+                }
+            };
+            let t_max = if i % 10 == 0 { 0.5 } else { 1e30 };
+            TraceRay {
+                origin: origin.to_array(),
+                t_max,
+                dir: dir.to_array(),
+                pad: 0.0,
+            }
+        })
+        .collect();
+    let hits = trace_on_gpu(&gpu_scene, &rays);
+    let (mut hit_count, mut mesh_hits, mut mismatches) = (0, 0, 0);
+    for (ray, gpu) in rays.iter().zip(&hits) {
+        let cpu = gpu_scene.intersect(
+            &Ray {
+                origin: ray.origin.into(),
+                dir: ray.dir.into(),
+            },
+            ray.t_max,
+        );
+        match cpu {
+            None => assert_eq!(
+                gpu.object,
+                u32::MAX,
+                "GPU hit {gpu:?} where the CPU twin misses"
+            ),
+            Some(cpu) => {
+                hit_count += 1;
+                assert!(
+                    (gpu.t - cpu.t).abs() <= 1e-4 * cpu.t.max(1.0),
+                    "t: GPU {gpu:?}, CPU {cpu:?}"
+                );
+                if (gpu.object, gpu.primitive) != (cpu.object, cpu.primitive) {
+                    // Only a ray through a shared edge may pick either neighbour.
+                    mismatches += 1;
+                }
+                mesh_hits += usize::from(gpu_scene.objects[gpu.object as usize].kind == KIND_MESH);
+            }
+        }
+    }
+    assert!(
+        hit_count > 10_000 && mesh_hits > 200,
+        "{hit_count} hits, {mesh_hits} on the vase"
+    );
+    assert!(
+        mismatches <= 5,
+        "{mismatches} rays hit a different primitive on the GPU"
+    );
+}
