@@ -2,9 +2,7 @@
 //! emitters seen directly, accumulation precision), a Mitsuba 3 reference, and the default
 //! scene. Images are small so the suite stays fast on the CPU adapter.
 
-mod common;
-
-use common::{context, read_exr, render, repo, scene};
+use crate::common::{context, read_exr, render, repo, scene};
 use glam::Vec3;
 use pathlight_core::default_scene;
 

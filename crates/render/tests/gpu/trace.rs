@@ -2,9 +2,7 @@
 //! through the default scene (quads, spheres, capped cylinders and a 6k-triangle mesh). The
 //! twin itself is checked against brute force in `crates/core/tests/bvh.rs`.
 
-mod common;
-
-use common::context;
+use crate::common::context;
 use glam::Vec3;
 use pathlight_core::gpu::KIND_MESH;
 use pathlight_core::trace::Ray;

@@ -1,0 +1,5 @@
+//! GPU tests on a real wgpu adapter (lavapipe on CI), one binary sharing one device.
+
+mod common;
+mod render;
+mod trace;
