@@ -26,6 +26,8 @@ pub enum Command {
 pub enum Backend {
     /// WGSL compute shaders on a wgpu adapter (a GPU, or lavapipe/llvmpipe without one).
     Gpu,
+    /// The same transport in native Rust on all CPU cores (rayon).
+    Cpu,
 }
 
 /// Options of `pathlight render`.

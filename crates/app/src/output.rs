@@ -64,13 +64,8 @@ pub fn write(film: &Film, path: &Path) -> anyhow::Result<()> {
             )
             .with_context(|| format!("cannot write {}", path.display()))
         }
-        Format::Exr => {
-            let width = film.width as usize;
-            exr::prelude::write_rgb_file(path, width, film.height as usize, |x, y| {
-                let [r, g, b] = film.pixels[y * width + x];
-                (r, g, b)
-            })
-            .with_context(|| format!("cannot write {}", path.display()))
-        }
+        Format::Exr => film
+            .write_exr(path)
+            .with_context(|| format!("cannot write {}", path.display())),
     }
 }

@@ -5,12 +5,14 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use anyhow::{Context, anyhow};
+use pathlight_core::Film;
 use pathlight_core::load::{check_max_depth, check_resolution, check_spp};
 use pathlight_core::{GpuScene, Scene, default_scene, load_scene_file};
+use pathlight_cpu::CpuRenderer;
 use pathlight_render::context::{available_adapters, describe};
 use pathlight_render::{GpuContext, ProgressiveRenderer};
 
-use crate::cli::RenderArgs;
+use crate::cli::{Backend, RenderArgs};
 use crate::output;
 use crate::progress::Progress;
 
@@ -58,12 +60,52 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     result
 }
 
+/// A progressive renderer on either backend.
+enum Renderer<'a> {
+    Gpu(ProgressiveRenderer<'a>),
+    Cpu(CpuRenderer),
+}
+
+impl Renderer<'_> {
+    fn samples_done(&self) -> u32 {
+        match self {
+            Self::Gpu(r) => r.samples_done(),
+            Self::Cpu(r) => r.samples_done(),
+        }
+    }
+
+    fn advance(&mut self, max_samples: u32) -> anyhow::Result<u32> {
+        Ok(match self {
+            Self::Gpu(r) => r.advance(max_samples)?,
+            Self::Cpu(r) => r.advance(max_samples),
+        })
+    }
+
+    fn film(&self) -> anyhow::Result<Film> {
+        Ok(match self {
+            Self::Gpu(r) => r.read_film()?,
+            Self::Cpu(r) => r.film(),
+        })
+    }
+}
+
 fn render_to_file(scene: &Scene, args: &RenderArgs) -> anyhow::Result<()> {
     let started = Instant::now();
     let gpu_scene = GpuScene::build(scene);
-    let ctx = GpuContext::new(args.adapter.as_deref())?;
-    eprintln!("adapter: {}", describe(&ctx.adapter_info));
-    let mut renderer = ProgressiveRenderer::new(&ctx, scene, &gpu_scene)?;
+    let ctx = match args.backend {
+        Backend::Gpu => Some(GpuContext::new(args.adapter.as_deref())?),
+        Backend::Cpu => None,
+    };
+    let mut renderer = match &ctx {
+        Some(ctx) => {
+            eprintln!("adapter: {}", describe(&ctx.adapter_info));
+            Renderer::Gpu(ProgressiveRenderer::new(ctx, scene, &gpu_scene)?)
+        }
+        None => {
+            eprintln!("backend: cpu, {} threads", rayon::current_num_threads());
+            Renderer::Cpu(CpuRenderer::new(scene, gpu_scene))
+        }
+    };
 
     let interrupted = Arc::new(AtomicBool::new(false));
     let flag = interrupted.clone();
@@ -80,7 +122,7 @@ fn render_to_file(scene: &Scene, args: &RenderArgs) -> anyhow::Result<()> {
     }
     progress.finish();
     let render_time = render_started.elapsed();
-    let film = renderer.read_film()?;
+    let film = renderer.film()?;
     if film.spp == 0 {
         anyhow::bail!("interrupted before the first sample; nothing written");
     }

@@ -17,8 +17,8 @@ use obvhs::bvh2::builder::{build_bvh2, build_bvh2_from_tris};
 use obvhs::triangle::Triangle;
 
 use crate::gpu::{
-    FLAG_CAPS, FLAG_FLAT, GpuBvhNode, GpuMaterial, GpuObject, GpuTextureInfo, GpuVertex,
-    KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE,
+    FLAG_CAPS, FLAG_FLAT, GpuBvhNode, GpuLight, GpuMaterial, GpuObject, GpuTextureInfo, GpuVertex,
+    KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE, NO_LIGHT,
 };
 use crate::scene::{Object, Scene, Shape, TriangleMesh};
 
@@ -39,6 +39,10 @@ pub struct GpuScene {
     pub texels: Vec<u32>,
     /// Number of real objects (`objects` may hold a placeholder).
     pub object_count: u32,
+    /// The light table. Never empty (a placeholder when nothing emits).
+    pub lights: Vec<GpuLight>,
+    /// Number of real lights (`lights` may hold a placeholder).
+    pub light_count: u32,
 }
 
 fn node_from(node: &obvhs::bvh2::node::Bvh2Node, index_base: u32) -> GpuBvhNode {
@@ -158,7 +162,9 @@ fn gpu_object(object: &Object, id: u32) -> GpuObject {
         blas_root: 0,
         id,
         flags: 0,
-        pad: [0; 3],
+        light: NO_LIGHT,
+        first_triangle: 0,
+        pad: 0,
     };
     match object.shape {
         Shape::Quad {
@@ -235,11 +241,13 @@ impl GpuScene {
                 let object = &scene.objects[id as usize];
                 let mut gpu = gpu_object(object, id);
                 if let Shape::Mesh(mesh) = &object.shape {
+                    gpu.first_triangle = (out.vertices.len() / 3) as u32;
                     gpu.blas_root = out.append_mesh(mesh);
                 }
                 out.objects.push(gpu);
             }
         }
+        out.build_lights();
         if out.objects.is_empty() {
             out.objects.push(GpuObject::zeroed());
         }
@@ -255,7 +263,104 @@ impl GpuScene {
         if out.materials.is_empty() {
             out.materials.push(GpuMaterial::zeroed());
         }
+        if out.lights.is_empty() {
+            out.lights.push(GpuLight::zeroed());
+        }
         out
+    }
+
+    /// Surface area of light-table entry `(object, primitive)`.
+    fn emitter_area(&self, object: &GpuObject, primitive: u32) -> f32 {
+        let [a, b, c] = [object.a, object.b, object.c].map(|v| Vec3::from_slice(&v));
+        match object.kind {
+            KIND_QUAD => b.cross(c).length(),
+            KIND_SPHERE => 4.0 * std::f32::consts::PI * object.a[3] * object.a[3],
+            KIND_CYLINDER => {
+                let r = object.a[3];
+                let caps = if object.flags & FLAG_CAPS != 0 {
+                    2.0
+                } else {
+                    0.0
+                };
+                std::f32::consts::TAU * r * (b - a).length() + caps * std::f32::consts::PI * r * r
+            }
+            _ => {
+                let [v0, v1, v2] = self.triangle(primitive);
+                0.5 * (v1 - v0).cross(v2 - v0).length()
+            }
+        }
+    }
+
+    /// Fills the light table from the emissive objects (power = area x luminance) and
+    /// points each emissive object at its entries. Rebuild it after changing emission.
+    pub fn build_lights(&mut self) {
+        self.lights.clear();
+        let mut powers = Vec::new();
+        for i in 0..self.object_count as usize {
+            let object = self.objects[i];
+            let e = self
+                .materials
+                .get(object.material as usize)
+                .map_or(Vec3::ZERO, |m| Vec3::from(m.emission));
+            let luminance = e
+                .dot(Vec3::new(0.2126, 0.7152, 0.0722))
+                .max(e.max_element() * 1e-3);
+            self.objects[i].light = NO_LIGHT;
+            if luminance <= 0.0 {
+                continue;
+            }
+            let primitives = if object.kind == KIND_MESH {
+                let count = self.mesh_triangle_count(object.blas_root);
+                object.first_triangle..object.first_triangle + count
+            } else {
+                0..1
+            };
+            let first = self.lights.len() as u32;
+            for primitive in primitives {
+                powers.push(self.emitter_area(&object, primitive) * luminance);
+                self.lights.push(GpuLight {
+                    object: i as u32,
+                    primitive,
+                    cdf: 0.0,
+                    pmf: 0.0,
+                });
+            }
+            self.objects[i].light = first;
+        }
+        let total: f64 = powers.iter().map(|&p| f64::from(p)).sum();
+        if total <= 0.0 || !total.is_finite() {
+            // Only zero-area emitters: nothing can be sampled (or hit).
+            self.lights.clear();
+            self.objects.iter_mut().for_each(|o| o.light = NO_LIGHT);
+        }
+        let mut running = 0.0f64;
+        for (light, power) in self.lights.iter_mut().zip(&powers) {
+            running += f64::from(*power);
+            light.pmf = (f64::from(*power) / total) as f32;
+            light.cdf = (running / total) as f32;
+        }
+        if let Some(last) = self.lights.last_mut() {
+            last.cdf = 1.0;
+        }
+        self.light_count = self.lights.len() as u32;
+        if self.lights.is_empty() {
+            self.lights.push(GpuLight::zeroed());
+        }
+    }
+
+    /// Number of triangles under the BLAS rooted at `root`.
+    fn mesh_triangle_count(&self, root: u32) -> u32 {
+        let mut stack = vec![root];
+        let mut count = 0;
+        while let Some(i) = stack.pop() {
+            let node = &self.nodes[i as usize];
+            if node.prim_count == 0 {
+                stack.extend([node.first_index, node.first_index + 1]);
+            } else {
+                count += node.prim_count;
+            }
+        }
+        count
     }
 
     /// Appends a mesh's BLAS and triangles; returns the BLAS root's node index.

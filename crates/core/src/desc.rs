@@ -91,6 +91,19 @@ pub struct RenderDesc {
     pub rr_depth: u32,
     /// Seed of the random sequence.
     pub seed: u32,
+    /// Sample generator.
+    pub sampler: SamplerDesc,
+}
+
+/// The sample generator.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SamplerDesc {
+    /// Padded Owen-scrambled Sobol (the default).
+    #[default]
+    Sobol,
+    /// Independent hashed random numbers.
+    Independent,
 }
 
 impl Default for RenderDesc {
@@ -100,6 +113,7 @@ impl Default for RenderDesc {
             max_depth: 8,
             rr_depth: 5,
             seed: 0,
+            sampler: SamplerDesc::Sobol,
         }
     }
 }

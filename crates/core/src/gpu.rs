@@ -15,6 +15,14 @@ pub const KIND_CYLINDER: u32 = 2;
 /// [`GpuObject::kind`] of a triangle mesh.
 pub const KIND_MESH: u32 = 3;
 
+/// [`GpuObject::light`] of an object that does not emit.
+pub const NO_LIGHT: u32 = u32::MAX;
+
+/// [`GpuFrameParams::sampler`]: padded Owen-scrambled Sobol.
+pub const SAMPLER_SOBOL: u32 = 0;
+/// [`GpuFrameParams::sampler`]: independent hashed random numbers.
+pub const SAMPLER_INDEPENDENT: u32 = 1;
+
 /// [`GpuObject::flags`] bit: shade a mesh with geometric normals.
 pub const FLAG_FLAT: u32 = 1;
 /// [`GpuObject::flags`] bit: a cylinder closed by two disks.
@@ -44,10 +52,32 @@ pub struct GpuObject {
     pub id: u32,
     /// `FLAG_*` bits.
     pub flags: u32,
+    /// Its first entry in the light table, or [`NO_LIGHT`]. A mesh has one entry per
+    /// triangle: triangle `t` is entry `light + t - first_triangle`.
+    pub light: u32,
+    /// Mesh only: index of its first triangle in the vertex buffer (in triangles).
+    pub first_triangle: u32,
     /// Padding to 16 bytes.
-    pub pad: [u32; 3],
+    pub pad: u32,
 }
 const _: () = assert!(size_of::<GpuObject>() == 80);
+
+/// One emitter a path can sample: a whole quad, sphere or cylinder, or one triangle of an
+/// emissive mesh, chosen with probability proportional to its power. WGSL: `Light`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuLight {
+    /// Index into the object buffer (top-level order).
+    pub object: u32,
+    /// Triangle index for a mesh light, 0 otherwise.
+    pub primitive: u32,
+    /// Probability of choosing a light up to and including this one (among the shape
+    /// lights; the environment is chosen first with `env_pmf`).
+    pub cdf: f32,
+    /// Probability of choosing this light among the shape lights.
+    pub pmf: f32,
+}
+const _: () = assert!(size_of::<GpuLight>() == 16);
 
 /// One BVH2 node in the layout of `obvhs::bvh2::node::Bvh2Node`. WGSL: `BvhNode`.
 ///
@@ -171,8 +201,16 @@ pub struct GpuFrameParams {
     pub object_count: u32,
     /// First row this dispatch covers (long renders are split into row bands).
     pub row_offset: u32,
+    /// Number of entries in the light table.
+    pub light_count: u32,
+    /// Probability of sampling the environment rather than a shape light.
+    pub env_pmf: f32,
+    /// `SAMPLER_*`.
+    pub sampler: u32,
+    /// End (exclusive) of the row band this dispatch covers.
+    pub row_end: u32,
 }
-const _: () = assert!(size_of::<GpuFrameParams>() == 96);
+const _: () = assert!(size_of::<GpuFrameParams>() == 112);
 
 /// One pixel of the accumulation buffer. WGSL: `AccumPixel`.
 ///

@@ -5,6 +5,8 @@ pub mod accel;
 pub mod default_scene;
 pub mod desc;
 pub mod error;
+pub mod film;
+pub mod frame;
 pub mod gpu;
 pub mod load;
 pub mod mesh;
@@ -15,5 +17,6 @@ pub mod trace;
 
 pub use accel::GpuScene;
 pub use error::SceneError;
+pub use film::Film;
 pub use load::{SceneSource, load_scene, load_scene_file};
 pub use scene::{Camera, Material, Object, RenderSettings, Scene, Shape};

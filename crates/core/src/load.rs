@@ -7,8 +7,9 @@ use std::path::{Path, PathBuf};
 use glam::{Vec2, Vec3};
 use toml::Spanned;
 
-use crate::desc::{ColorSpace, MaterialDesc, RenderDesc, SceneDesc, Shading};
+use crate::desc::{ColorSpace, MaterialDesc, RenderDesc, SamplerDesc, SceneDesc, Shading};
 use crate::error::SceneError;
+use crate::gpu::{SAMPLER_INDEPENDENT, SAMPLER_SOBOL};
 use crate::revolve::Revolution;
 use crate::scene::{
     Camera, Conductor, MAX_DEPTH, MAX_RESOLUTION, MAX_SPP, Material, Object, RenderSettings, Scene,
@@ -444,6 +445,10 @@ impl From<&RenderDesc> for RenderSettings {
             max_depth: r.max_depth,
             rr_depth: r.rr_depth,
             seed: r.seed,
+            sampler: match r.sampler {
+                SamplerDesc::Sobol => SAMPLER_SOBOL,
+                SamplerDesc::Independent => SAMPLER_INDEPENDENT,
+            },
         }
     }
 }

@@ -37,6 +37,8 @@ pub struct RenderSettings {
     pub rr_depth: u32,
     /// Seed of the random sequence.
     pub seed: u32,
+    /// `gpu::SAMPLER_*`: Owen-scrambled Sobol or independent random numbers.
+    pub sampler: u32,
 }
 
 /// A conductor's complex index of refraction, per RGB channel.

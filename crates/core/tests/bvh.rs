@@ -24,6 +24,7 @@ fn scene_of(objects: Vec<Object>) -> Scene {
             max_depth: 8,
             rr_depth: 5,
             seed: 0,
+            sampler: 0,
         },
         environment: Vec3::ZERO,
         materials: Vec::new(),

@@ -1,18 +1,40 @@
-// The material model (SPEC section 4) as a mixture of lobes chosen by their weights:
-// diffuse (1 - specular_rate - refract_rate), specular reflection (specular_rate) and
-// transmission (refract_rate). Sampling picks one lobe with probability equal to its
-// weight and returns f * cos / pdf of that lobe, an unbiased one-sample estimate of the
-// mixture. Lobes implemented here: two-sided Lambert; smooth conductor (complex-IOR
-// Fresnel, or Schlick from the specular colour); smooth dielectric with exact Fresnel.
+// The material model. CPU twin: `crates/cpu/src/bsdf.rs` (read its header for the model).
+//
+// A mixture of lobes with the seed's weights: Lambert, specular reflection (smooth mirror
+// or GGX conductor: complex-IOR Fresnel, or Schlick from the specular colour) and
+// transmission (smooth or GGX-rough dielectric, Walter et al. 2007 as in pbrt-v4, exact
+// Fresnel). GGX: separable Smith G1(wo) G1(wi) as in Mitsuba 3, alpha = roughness^2,
+// visible-normal sampling (Heitz 2018). `eval_bsdf` returns f * |cos_i| of the non-delta
+// lobes and the density of `sample_bsdf` producing wi.
+
+const ALPHA_MIN: f32 = 1e-3;
+
+struct BsdfEval {
+    f: vec3f,
+    pdf: f32,
+}
 
 struct BsdfSample {
     wi: vec3f,
-    // f * |cos| / pdf.
+    // f * |cos| / pdf (for a delta lobe: its reflectance or transmittance).
     weight: vec3f,
+    // Density of the whole mixture at wi; 0 for a delta lobe.
+    pdf: f32,
+    delta: bool,
+    // Relative IOR crossed by a refraction, else 1.
+    eta: f32,
     valid: bool,
 }
 
-// Unpolarised Fresnel reflectance of a dielectric; eta = n_transmitted / n_incident.
+fn invalid_sample() -> BsdfSample {
+    return BsdfSample(vec3f(0.0), vec3f(0.0), 0.0, false, 1.0, false);
+}
+
+fn to_local(frame: mat3x3f, v: vec3f) -> vec3f {
+    return vec3f(dot(v, frame[0]), dot(v, frame[1]), dot(v, frame[2]));
+}
+
+// eta = n_transmitted / n_incident, cos_i >= 0.
 fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
     if sin2_t >= 1.0 {
@@ -24,8 +46,7 @@ fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     return 0.5 * (rs * rs + rp * rp);
 }
 
-// Unpolarised Fresnel reflectance of a conductor with IOR eta + i k (Mitsuba 3's
-// `fresnel_conductor`).
+// Mitsuba 3's `fresnel_conductor`.
 fn fresnel_conductor(cos_i: f32, eta: vec3f, k: vec3f) -> vec3f {
     let cos2 = cos_i * cos_i;
     let sin2 = 1.0 - cos2;
@@ -43,44 +64,238 @@ fn fresnel_conductor(cos_i: f32, eta: vec3f, k: vec3f) -> vec3f {
     return 0.5 * (rp + rs);
 }
 
-fn specular_reflectance(material: Material, color: vec3f, cos_i: f32) -> vec3f {
-    if material.conductor != 0u {
-        return fresnel_conductor(cos_i, material.eta, material.k);
+fn specular_reflectance(m: Material, color: vec3f, cos_i: f32) -> vec3f {
+    if m.conductor != 0u {
+        return fresnel_conductor(cos_i, m.eta, m.k);
     }
-    let f0 = mix(vec3f(1.0), color, material.specular_tint);
+    let f0 = mix(vec3f(1.0), color, m.specular_tint);
     return f0 + (1.0 - f0) * pow(1.0 - saturate(cos_i), 5.0);
 }
 
-// Samples the material at `s` for outgoing direction `wo` (unit, pointing away).
-fn sample_bsdf(material: Material, color: vec3f, s: Surface, wo: vec3f, u_lobe: f32, u_fresnel: f32, u: vec2f) -> BsdfSample {
+fn ggx_d(m: vec3f, alpha: f32) -> f32 {
+    let a2 = alpha * alpha;
+    let t = (m.x * m.x + m.y * m.y) / a2 + m.z * m.z;
+    return 1.0 / (PI * a2 * t * t);
+}
+
+fn ggx_g1(w: vec3f, alpha: f32) -> f32 {
+    let z2 = w.z * w.z;
+    if z2 <= 0.0 {
+        return 0.0;
+    }
+    let tan2 = (w.x * w.x + w.y * w.y) / z2;
+    return 2.0 / (1.0 + sqrt(1.0 + alpha * alpha * tan2));
+}
+
+fn ggx_sample_visible(wo: vec3f, alpha: f32, u: vec2f) -> vec3f {
+    let w = select(wo, -wo, wo.z < 0.0);
+    let vh = normalize(vec3f(alpha * w.x, alpha * w.y, w.z));
+    let len2 = vh.x * vh.x + vh.y * vh.y;
+    let t1 = select(vec3f(1.0, 0.0, 0.0), vec3f(-vh.y, vh.x, 0.0) / sqrt(len2), len2 > 0.0);
+    let t2 = cross(vh, t1);
+    let r = sqrt(u.x);
+    let phi = TAU * u.y;
+    let p1 = r * cos(phi);
+    let s = 0.5 * (1.0 + vh.z);
+    let p2 = (1.0 - s) * sqrt(max(0.0, 1.0 - p1 * p1)) + s * r * sin(phi);
+    let nh = p1 * t1 + p2 * t2 + sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
+    return normalize(vec3f(alpha * nh.x, alpha * nh.y, max(nh.z, 1e-7)));
+}
+
+fn ggx_pdf_visible(wo: vec3f, m: vec3f, alpha: f32) -> f32 {
+    return ggx_g1(wo, alpha) * abs(dot(wo, m)) * ggx_d(m, alpha) / abs(wo.z);
+}
+
+fn lobe_weights(m: Material) -> vec3f {
+    return vec3f(max(0.0, 1.0 - m.specular_rate - m.refract_rate), m.specular_rate, m.refract_rate);
+}
+
+fn fresnel_dielectric_local(cos_om: f32, ior: f32) -> f32 {
+    if cos_om >= 0.0 {
+        return fresnel_dielectric(cos_om, ior);
+    }
+    return fresnel_dielectric(-cos_om, 1.0 / ior);
+}
+
+fn eval_rough_dielectric(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: vec3f, alpha: f32) -> BsdfEval {
+    let none = BsdfEval(vec3f(0.0), 0.0);
+    let frame = frame_around(s.ns);
+    let wo_l = to_local(frame, wo);
+    let wi_l = to_local(frame, wi);
+    let cos_o = wo_l.z;
+    let cos_i = wi_l.z;
+    let geo_reflect = (dot(wo, s.ng) >= 0.0) == (dot(wi, s.ng) >= 0.0);
+    let reflect = cos_o * cos_i > 0.0;
+    if cos_o == 0.0 || cos_i == 0.0 || reflect != geo_reflect {
+        return none;
+    }
+    var etap = 1.0;
+    if !reflect {
+        etap = select(1.0 / m.ior, m.ior, cos_o > 0.0);
+    }
+    var h = wi_l * etap + wo_l;
+    if dot(h, h) == 0.0 {
+        return none;
+    }
+    h = normalize(h);
+    if h.z < 0.0 {
+        h = -h;
+    }
+    if dot(h, wi_l) * cos_i < 0.0 || dot(h, wo_l) * cos_o < 0.0 {
+        return none;
+    }
+    let fr = fresnel_dielectric_local(dot(wo_l, h), m.ior);
+    let d = ggx_d(h, alpha);
+    let g = ggx_g1(wo_l, alpha) * ggx_g1(wi_l, alpha);
+    let pdf_h = ggx_pdf_visible(wo_l, h, alpha);
+    if reflect {
+        return BsdfEval(vec3f(d * g * fr / (4.0 * abs(cos_o))), pdf_h / (4.0 * abs(dot(wo_l, h))) * fr);
+    }
+    let x = dot(wi_l, h) + dot(wo_l, h) / etap;
+    let denom = x * x;
+    let tint = mix(vec3f(1.0), color, m.refract_tint);
+    let ft = (1.0 - fr) * d * g * abs(dot(wi_l, h) * dot(wo_l, h)) / (abs(cos_o) * denom) / (etap * etap);
+    return BsdfEval(tint * ft, pdf_h * abs(dot(wi_l, h)) / denom * (1.0 - fr));
+}
+
+fn eval_bsdf(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: vec3f) -> BsdfEval {
+    let weights = lobe_weights(m);
     let front = dot(wo, s.ng) >= 0.0;
     let ng = select(-s.ng, s.ng, front);
     let n = select(-s.ns, s.ns, front);
-    var out = BsdfSample(vec3f(0.0), vec3f(0.0), false);
+    var out = BsdfEval(vec3f(0.0), 0.0);
+    let cos_o = dot(wo, n);
+    let cos_i = dot(wi, n);
+    if dot(wi, ng) > 0.0 && cos_o > 0.0 && cos_i > 0.0 {
+        if weights.x > 0.0 {
+            out.f += weights.x * color * (cos_i / PI);
+            out.pdf += weights.x * cos_i / PI;
+        }
+        let alpha = m.specular_roughness * m.specular_roughness;
+        if weights.y > 0.0 && alpha >= ALPHA_MIN {
+            let frame = frame_around(n);
+            let wo_l = to_local(frame, wo);
+            let wi_l = to_local(frame, wi);
+            let h = normalize(wo_l + wi_l);
+            let f = specular_reflectance(m, color, dot(wo_l, h));
+            let d = ggx_d(h, alpha);
+            let g1o = ggx_g1(wo_l, alpha);
+            out.f += weights.y * f * d * g1o * ggx_g1(wi_l, alpha) / (4.0 * wo_l.z);
+            out.pdf += weights.y * g1o * d / (4.0 * wo_l.z);
+        }
+    }
+    let alpha_t = m.refract_roughness * m.refract_roughness;
+    if weights.z > 0.0 && alpha_t >= ALPHA_MIN {
+        let e = eval_rough_dielectric(m, color, s, wo, wi, alpha_t);
+        out.f += weights.z * e.f;
+        out.pdf += weights.z * e.pdf;
+    }
+    return out;
+}
+
+fn mixture_sample(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: vec3f) -> BsdfSample {
+    let e = eval_bsdf(m, color, s, wo, wi);
+    if !(e.pdf > 0.0 && e.pdf <= 3.0e38) {
+        return invalid_sample();
+    }
+    let front_o = dot(wo, s.ng) >= 0.0;
+    var eta = 1.0;
+    if front_o != (dot(wi, s.ng) >= 0.0) {
+        eta = select(1.0 / m.ior, m.ior, front_o);
+    }
+    return BsdfSample(wi, e.f / e.pdf, e.pdf, false, eta, true);
+}
+
+fn sample_smooth_dielectric(m: Material, color: vec3f, s: Surface, wo: vec3f, u_fresnel: f32) -> BsdfSample {
+    let front = dot(wo, s.ng) >= 0.0;
+    let ng = select(-s.ng, s.ng, front);
+    let n = select(-s.ns, s.ns, front);
     let cos_o = dot(wo, n);
     if cos_o <= 0.0 {
-        return out;
+        return invalid_sample();
     }
-    if u_lobe < material.specular_rate {
-        out.wi = reflect(-wo, n);
-        out.weight = specular_reflectance(material, color, cos_o);
-    } else if u_lobe < material.specular_rate + material.refract_rate {
-        // Entering when we are on the front (outside) of the surface.
-        let eta = select(1.0 / material.ior, material.ior, front);
-        let f = fresnel_dielectric(cos_o, eta);
-        if u_fresnel < f {
-            out.wi = reflect(-wo, n);
-            out.weight = vec3f(1.0);
-        } else {
-            out.wi = refract(-wo, n, 1.0 / eta);
-            out.weight = mix(vec3f(1.0), color, material.refract_tint);
-            out.valid = dot(out.wi, ng) < 0.0 && dot(out.wi, out.wi) > 0.5;
-            return out;
+    let eta = select(1.0 / m.ior, m.ior, front);
+    let f = fresnel_dielectric(cos_o, eta);
+    if u_fresnel < f {
+        let wi = 2.0 * cos_o * n - wo;
+        return BsdfSample(wi, vec3f(1.0), 0.0, true, 1.0, dot(wi, ng) > 0.0);
+    }
+    let sin2_t = (1.0 - cos_o * cos_o) / (eta * eta);
+    let cos_t = sqrt(max(0.0, 1.0 - sin2_t));
+    let wi = -wo / eta + (cos_o / eta - cos_t) * n;
+    let weight = mix(vec3f(1.0), color, m.refract_tint) / (eta * eta);
+    return BsdfSample(wi, weight, 0.0, true, eta, dot(wi, ng) < 0.0);
+}
+
+fn sample_bsdf(m: Material, color: vec3f, s: Surface, wo: vec3f, u_lobe: f32, u_fresnel: f32, u: vec2f) -> BsdfSample {
+    let weights = lobe_weights(m);
+    let front = dot(wo, s.ng) >= 0.0;
+    let ng = select(-s.ng, s.ng, front);
+    let n = select(-s.ns, s.ns, front);
+    let cos_o = dot(wo, n);
+    if u_lobe < weights.y {
+        if cos_o <= 0.0 {
+            return invalid_sample();
         }
-    } else {
-        out.wi = frame_around(n) * sample_cosine_hemisphere(u);
-        out.weight = color;
+        let alpha = m.specular_roughness * m.specular_roughness;
+        if alpha < ALPHA_MIN {
+            let wi = 2.0 * cos_o * n - wo;
+            if dot(wi, ng) <= 0.0 {
+                return invalid_sample();
+            }
+            return BsdfSample(wi, specular_reflectance(m, color, cos_o), 0.0, true, 1.0, true);
+        }
+        let frame = frame_around(n);
+        let wo_l = to_local(frame, wo);
+        let h = ggx_sample_visible(wo_l, alpha, u);
+        let wi_l = 2.0 * dot(wo_l, h) * h - wo_l;
+        if wi_l.z <= 0.0 {
+            return invalid_sample();
+        }
+        return mixture_sample(m, color, s, wo, frame * wi_l);
     }
-    out.valid = dot(out.wi, ng) > 0.0;
-    return out;
+    if u_lobe < weights.y + weights.z {
+        let alpha = m.refract_roughness * m.refract_roughness;
+        if alpha < ALPHA_MIN {
+            return sample_smooth_dielectric(m, color, s, wo, u_fresnel);
+        }
+        let frame = frame_around(s.ns);
+        let wo_l = to_local(frame, wo);
+        if wo_l.z == 0.0 {
+            return invalid_sample();
+        }
+        let h = ggx_sample_visible(wo_l, alpha, u);
+        let cos_oh = dot(wo_l, h);
+        let fr = fresnel_dielectric_local(cos_oh, m.ior);
+        var wi_l: vec3f;
+        if u_fresnel < fr {
+            wi_l = 2.0 * cos_oh * h - wo_l;
+        } else {
+            let outside = cos_oh >= 0.0;
+            let eta = select(1.0 / m.ior, m.ior, outside);
+            let hf = select(-h, h, outside);
+            let c = abs(cos_oh);
+            let sin2_t = (1.0 - c * c) / (eta * eta);
+            if sin2_t >= 1.0 {
+                return invalid_sample();
+            }
+            wi_l = -wo_l / eta + (c / eta - sqrt(1.0 - sin2_t)) * hf;
+        }
+        return mixture_sample(m, color, s, wo, frame * wi_l);
+    }
+    if cos_o <= 0.0 {
+        return invalid_sample();
+    }
+    let wi = frame_around(n) * sample_cosine_hemisphere(u);
+    if dot(wi, ng) <= 0.0 {
+        return invalid_sample();
+    }
+    return mixture_sample(m, color, s, wo, wi);
+}
+
+fn has_continuous_lobe(m: Material) -> bool {
+    let w = lobe_weights(m);
+    return w.x > 0.0
+        || (w.y > 0.0 && m.specular_roughness * m.specular_roughness >= ALPHA_MIN)
+        || (w.z > 0.0 && m.refract_roughness * m.refract_roughness >= ALPHA_MIN);
 }

@@ -1,8 +1,10 @@
 // The progressive path-tracing pass. One invocation per pixel of a band of rows adds
 // `batch_samples` jittered (box-filtered) samples to an exact fixed-point accumulation
-// buffer. Paths are unidirectional with BSDF sampling, `max_depth` counted in segments as
-// Mitsuba counts it, and Russian roulette from `rr_depth`. Non-finite samples are dropped
-// (counted as zero) so no NaN or Inf reaches the film.
+// buffer. Paths are unidirectional: next-event estimation and BSDF sampling combined with
+// the power heuristic, `max_depth` counted in segments as Mitsuba counts it, Russian
+// roulette from `rr_depth` on the throughput without the 1/eta^2 radiance scaling (as
+// Mitsuba). Non-finite samples are dropped (counted as zero), so no NaN or Inf reaches
+// the film. CPU twin: `crates/cpu/src/integrator.rs`.
 
 // Per-batch constants. Host: `GpuFrameParams`.
 struct FrameParams {
@@ -20,6 +22,10 @@ struct FrameParams {
     seed: u32,
     object_count: u32,
     row_offset: u32,
+    light_count: u32,
+    env_pmf: f32,
+    sampler: u32,
+    row_end: u32,
 }
 
 // Running sum of samples per channel as a 64-bit fixed-point number hi + lo / 2^32.
@@ -66,8 +72,8 @@ fn offset_origin(p: vec3f, ng: vec3f, dir: vec3f) -> vec3f {
     return p + select(-ng, ng, dot(dir, ng) > 0.0) * eps;
 }
 
-fn camera_ray(x: u32, y: u32, rng: ptr<function, u32>) -> Ray {
-    let jitter = vec2f(rng_next(rng), rng_next(rng));
+fn camera_ray(x: u32, y: u32, sampler: ptr<function, Sampler>) -> Ray {
+    let jitter = next_2d(sampler);
     let ndc = vec2f(
         2.0 * (f32(x) + jitter.x) / f32(params.width) - 1.0,
         1.0 - 2.0 * (f32(y) + jitter.y) / f32(params.height),
@@ -76,37 +82,85 @@ fn camera_ray(x: u32, y: u32, rng: ptr<function, u32>) -> Ray {
     return Ray(params.camera_position, normalize(dir));
 }
 
-fn trace_path(first: Ray, rng: ptr<function, u32>) -> vec3f {
+// Whether anything blocks light sample `ls` from surface point p (normal ng): the shadow
+// ray runs from the offset origin to the light point, stopping just short of it.
+fn occluded(p: vec3f, ng: vec3f, ls: LightSample) -> bool {
+    let origin = offset_origin(p, ng, ls.wi);
+    if !ls.finite {
+        return intersect_scene(Ray(origin, ls.wi), T_MAX, params.object_count).object != NO_HIT;
+    }
+    let to_light = ls.point - origin;
+    let distance = length(to_light);
+    let hit = intersect_scene(Ray(origin, to_light / distance), distance * (1.0 - 1e-4), params.object_count);
+    return hit.object != NO_HIT;
+}
+
+fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
     var ray = first;
     var radiance = vec3f(0.0);
     var throughput = vec3f(1.0);
+    // The BSDF sample that produced `ray`: its density and whether it was a delta lobe
+    // (camera rays count as delta: emitters they see get full weight).
+    var prev_pdf = 0.0;
+    var prev_delta = true;
+    var prev_position = ray.origin;
+    // Normal (on the side of wo) at the vertex that produced `ray`.
+    var prev_normal = vec3f(0.0);
+    var eta_scale = 1.0;
     for (var depth = 1u; depth <= params.max_depth; depth++) {
         let hit = intersect_scene(ray, T_MAX, params.object_count);
         if hit.object == NO_HIT {
-            radiance += throughput * params.environment;
+            var w = 1.0;
+            if !prev_delta {
+                w = power_heuristic(prev_pdf, env_pdf(prev_normal, ray.dir));
+            }
+            radiance += throughput * params.environment * w;
             break;
         }
         let s = surface_at(hit, ray);
         let material = materials[s.material];
         let wo = -ray.dir;
-        if dot(wo, s.ng) > 0.0 {
-            radiance += throughput * material.emission;
+        if dot(wo, s.ng) > 0.0 && max(max(material.emission.x, material.emission.y), material.emission.z) > 0.0 {
+            var w = 1.0;
+            if !prev_delta && objects[hit.object].light != NO_LIGHT {
+                w = power_heuristic(prev_pdf, light_pdf(hit.object, hit.primitive, prev_position, s.position, s.ng));
+            }
+            radiance += throughput * material.emission * w;
         }
         if depth == params.max_depth {
             break;
         }
+        // Every bounce draws the same dimensions in the same order.
+        let u_light_select = next_1d(sampler);
+        let u_light = next_2d(sampler);
+        let u_lobe = next_1d(sampler);
+        let u_fresnel = next_1d(sampler);
+        let u_bsdf = next_2d(sampler);
+        let u_rr = next_1d(sampler);
         let color = base_color(material, s.uv);
-        let u_lobe = rng_next(rng);
-        let u_fresnel = rng_next(rng);
-        let u = vec2f(rng_next(rng), rng_next(rng));
-        let bs = sample_bsdf(material, color, s, wo, u_lobe, u_fresnel, u);
+        let n = select(-s.ns, s.ns, dot(wo, s.ng) >= 0.0);
+        if has_continuous_lobe(material) {
+            let ls = sample_light(s.position, n, u_light_select, u_light);
+            if ls.valid {
+                let e = eval_bsdf(material, color, s, wo, ls.wi);
+                if max(max(e.f.x, e.f.y), e.f.z) > 0.0 && !occluded(s.position, s.ng, ls) {
+                    radiance += throughput * e.f * ls.radiance * power_heuristic(ls.pdf, e.pdf) / ls.pdf;
+                }
+            }
+        }
+        let bs = sample_bsdf(material, color, s, wo, u_lobe, u_fresnel, u_bsdf);
         if !bs.valid {
             break;
         }
         throughput *= bs.weight;
+        prev_pdf = bs.pdf;
+        prev_delta = bs.delta;
+        prev_position = s.position;
+        prev_normal = n;
+        eta_scale *= bs.eta;
         if depth >= params.rr_depth {
-            let q = min(max(max(throughput.x, throughput.y), throughput.z), 0.95);
-            if rng_next(rng) >= q {
+            let q = min(max(max(throughput.x, throughput.y), throughput.z) * eta_scale * eta_scale, 0.95);
+            if u_rr >= q {
                 break;
             }
             throughput /= q;
@@ -125,14 +179,14 @@ fn is_finite3(v: vec3f) -> bool {
 fn render(@builtin(global_invocation_id) gid: vec3u) {
     let x = gid.x;
     let y = gid.y + params.row_offset;
-    if x >= params.width || y >= params.height {
+    if x >= params.width || y >= params.row_end {
         return;
     }
     let pixel = y * params.width + x;
     var batch = AccumPixel(vec4u(0u), vec4u(0u));
     for (var i = 0u; i < params.batch_samples; i++) {
-        var rng = rng_init(pixel, params.sample_offset + i, params.seed);
-        let radiance = trace_path(camera_ray(x, y, &rng), &rng);
+        var sampler = sampler_init(params.sampler, pixel, params.sample_offset + i, params.seed);
+        let radiance = trace_path(camera_ray(x, y, &sampler), &sampler);
         if is_finite3(radiance) {
             add_sample(&batch, radiance);
         }

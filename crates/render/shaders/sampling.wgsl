@@ -1,4 +1,4 @@
-// Direction sampling and local frames.
+// Direction sampling, local frames and MIS weights. CPU twin: `crates/cpu/src/sampling.rs`.
 
 const PI: f32 = 3.14159265358979;
 const TAU: f32 = 6.28318530717959;
@@ -19,4 +19,29 @@ fn sample_cosine_hemisphere(u: vec2f) -> vec3f {
     let r = sqrt(u.x);
     let phi = TAU * u.y;
     return vec3f(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - u.x)));
+}
+
+// Uniform direction on the unit sphere; pdf = 1 / (4 pi).
+fn sample_uniform_sphere(u: vec2f) -> vec3f {
+    let z = 1.0 - 2.0 * u.x;
+    let r = sqrt(max(0.0, 1.0 - z * z));
+    let phi = TAU * u.y;
+    return vec3f(r * cos(phi), r * sin(phi), z);
+}
+
+// Uniform point on the unit disk (polar).
+fn sample_disk(u: vec2f) -> vec2f {
+    let r = sqrt(u.x);
+    let phi = TAU * u.y;
+    return vec2f(r * cos(phi), r * sin(phi));
+}
+
+// Power heuristic (beta = 2) weight of a strategy with density `a` against one with `b`.
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    let a2 = a * a;
+    let b2 = b * b;
+    if a2 + b2 > 0.0 && a2 <= 3.0e38 {
+        return a2 / (a2 + b2);
+    }
+    return select(0.0, 1.0, a2 > 3.0e38);
 }

@@ -19,9 +19,21 @@ struct Object {
     blas_root: u32,
     id: u32,
     flags: u32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
+    // First light-table entry, or NO_LIGHT; a mesh has one per triangle.
+    light: u32,
+    // Mesh: its first triangle index.
+    first_triangle: u32,
+    pad: u32,
+}
+
+const NO_LIGHT: u32 = 0xffffffffu;
+
+// One emitter chosen with probability pmf (cdf: cumulative). Host: `GpuLight`.
+struct Light {
+    object: u32,
+    primitive: u32,
+    cdf: f32,
+    pmf: f32,
 }
 
 // obvhs' Bvh2Node: prim_count 0 = inner node (children first_index, first_index + 1),
@@ -79,3 +91,4 @@ struct TextureInfo {
 @group(0) @binding(3) var<storage, read> materials: array<Material>;
 @group(0) @binding(4) var<storage, read> textures: array<TextureInfo>;
 @group(0) @binding(5) var<storage, read> texels: array<u32>;
+@group(0) @binding(6) var<storage, read> lights: array<Light>;

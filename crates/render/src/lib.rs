@@ -2,12 +2,11 @@
 
 pub mod context;
 pub mod error;
-pub mod film;
 pub mod renderer;
 pub mod scene_buffers;
 pub mod shaders;
 
 pub use context::GpuContext;
 pub use error::RenderError;
-pub use film::Film;
+pub use pathlight_core::Film;
 pub use renderer::ProgressiveRenderer;

@@ -6,12 +6,12 @@
 
 use std::time::{Duration, Instant};
 
+use pathlight_core::frame::frame_params;
 use pathlight_core::gpu::{GpuAccumPixel, GpuFrameParams};
-use pathlight_core::{GpuScene, Scene};
+use pathlight_core::{Film, GpuScene, Scene};
 
 use crate::context::GpuContext;
 use crate::error::RenderError;
-use crate::film::Film;
 use crate::scene_buffers::{SceneBuffers, create_compute_pipeline, storage_entry};
 use crate::shaders;
 
@@ -37,32 +37,8 @@ pub struct ProgressiveRenderer<'a> {
     /// Current piece size: rows per dispatch and samples per pixel per dispatch.
     rows_per_dispatch: u32,
     batch_samples: u32,
-}
-
-/// Camera vectors of the integrator: eye, forward, right and up scaled to the image plane.
-pub fn frame_params(scene: &Scene, object_count: u32) -> GpuFrameParams {
-    let c = &scene.camera;
-    let forward = (c.look_at - c.position).normalize();
-    let right = forward.cross(c.up).normalize();
-    let up = right.cross(forward);
-    let tan_half = (c.fov_y_deg.to_radians() * 0.5).tan();
-    let aspect = c.width as f32 / c.height as f32;
-    GpuFrameParams {
-        camera_position: c.position.to_array(),
-        width: c.width,
-        camera_forward: forward.to_array(),
-        height: c.height,
-        camera_right: (right * tan_half * aspect).to_array(),
-        sample_offset: 0,
-        camera_up: (up * tan_half).to_array(),
-        batch_samples: 1,
-        environment: scene.environment.to_array(),
-        max_depth: scene.settings.max_depth,
-        rr_depth: scene.settings.rr_depth,
-        seed: scene.settings.seed,
-        object_count,
-        row_offset: 0,
-    }
+    /// Whether the piece size follows the measured speed (see [`Self::set_piece`]).
+    adaptive: bool,
 }
 
 impl<'a> ProgressiveRenderer<'a> {
@@ -73,7 +49,7 @@ impl<'a> ProgressiveRenderer<'a> {
         gpu_scene: &GpuScene,
     ) -> Result<Self, RenderError> {
         let device = &ctx.device;
-        let params = frame_params(scene, gpu_scene.object_count);
+        let params = frame_params(scene, gpu_scene);
         let pixels = u64::from(params.width) * u64::from(params.height);
         let accum_size = pixels * size_of::<GpuAccumPixel>() as u64;
         let limit = device.limits().max_storage_buffer_binding_size;
@@ -147,9 +123,19 @@ impl<'a> ProgressiveRenderer<'a> {
             frame_bind_group,
             rows_per_dispatch: params.height.min(WORKGROUP * 4),
             batch_samples: 1,
+            adaptive: true,
             params,
             samples_done: 0,
         })
+    }
+
+    /// Fixes the piece size (rows per dispatch, samples per pixel per dispatch) instead of
+    /// sizing pieces from the measured speed. The image does not depend on it: samples are
+    /// seeded per (pixel, index) and summed exactly.
+    pub fn set_piece(&mut self, rows: u32, samples: u32) {
+        self.rows_per_dispatch = rows.clamp(1, self.params.height);
+        self.batch_samples = samples.clamp(1, MAX_BATCH_SAMPLES);
+        self.adaptive = false;
     }
 
     /// Samples per pixel accumulated so far.
@@ -182,6 +168,7 @@ impl<'a> ProgressiveRenderer<'a> {
                 sample_offset: self.samples_done,
                 batch_samples: samples,
                 row_offset: row,
+                row_end: row + rows,
                 ..self.params
             };
             self.ctx
@@ -207,7 +194,9 @@ impl<'a> ProgressiveRenderer<'a> {
             row += rows;
         }
         self.samples_done += samples;
-        self.reschedule(started.elapsed(), samples);
+        if self.adaptive {
+            self.reschedule(started.elapsed(), samples);
+        }
         Ok(samples)
     }
 
@@ -223,7 +212,9 @@ impl<'a> ProgressiveRenderer<'a> {
             self.batch_samples =
                 (per_submission / (width * height)).clamp(1, u64::from(MAX_BATCH_SAMPLES)) as u32;
         } else {
-            let rows = (per_submission / width).max(u64::from(WORKGROUP));
+            // Whole workgroups of rows, so no invocation idles at a band's edge.
+            let rows =
+                (per_submission / width / u64::from(WORKGROUP)).max(1) * u64::from(WORKGROUP);
             self.rows_per_dispatch = rows.min(height) as u32;
             self.batch_samples = 1;
         }

@@ -31,13 +31,14 @@ pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntr
 impl SceneBuffers {
     /// Uploads `scene`, refusing buffers over the device's binding limit.
     pub fn upload(device: &wgpu::Device, scene: &GpuScene) -> Result<Self, RenderError> {
-        let contents: [(&str, &[u8]); 6] = [
+        let contents: [(&str, &[u8]); 7] = [
             ("bvh nodes", bytemuck::cast_slice(&scene.nodes)),
             ("objects", bytemuck::cast_slice(&scene.objects)),
             ("vertices", bytemuck::cast_slice(&scene.vertices)),
             ("materials", bytemuck::cast_slice(&scene.materials)),
             ("texture table", bytemuck::cast_slice(&scene.textures)),
             ("texels", bytemuck::cast_slice(&scene.texels)),
+            ("lights", bytemuck::cast_slice(&scene.lights)),
         ];
         let limit = device.limits().max_storage_buffer_binding_size;
         let mut buffers = Vec::new();
@@ -59,7 +60,7 @@ impl SceneBuffers {
         }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene layout"),
-            entries: &(0..6).map(|i| storage_entry(i, true)).collect::<Vec<_>>(),
+            entries: &(0..7).map(|i| storage_entry(i, true)).collect::<Vec<_>>(),
         });
         let entries: Vec<_> = buffers
             .iter()

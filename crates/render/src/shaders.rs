@@ -7,26 +7,29 @@ pub const SCENE: &str = include_str!("../shaders/scene.wgsl");
 pub const INTERSECT: &str = include_str!("../shaders/intersect.wgsl");
 /// Two-level BVH traversal.
 pub const BVH: &str = include_str!("../shaders/bvh.wgsl");
-/// Hash-based random numbers.
-pub const RNG: &str = include_str!("../shaders/rng.wgsl");
+/// The sampler (Owen-scrambled Sobol, or hashed random numbers).
+pub const SAMPLER: &str = include_str!("../shaders/sampler.wgsl");
 /// Direction sampling and frames.
 pub const SAMPLING: &str = include_str!("../shaders/sampling.wgsl");
 /// Surface shading data from a hit.
 pub const SURFACE: &str = include_str!("../shaders/surface.wgsl");
 /// The material model.
 pub const BSDF: &str = include_str!("../shaders/bsdf.wgsl");
+/// Light sampling for next-event estimation.
+pub const LIGHTS: &str = include_str!("../shaders/lights.wgsl");
 /// The path-tracing pass (entry point `render`).
 pub const INTEGRATOR: &str = include_str!("../shaders/integrator.wgsl");
 
 /// Every shader file with its name, for validation.
-pub const FILES: [(&str, &str); 8] = [
+pub const FILES: [(&str, &str); 9] = [
     ("scene.wgsl", SCENE),
     ("intersect.wgsl", INTERSECT),
     ("bvh.wgsl", BVH),
-    ("rng.wgsl", RNG),
+    ("sampler.wgsl", SAMPLER),
     ("sampling.wgsl", SAMPLING),
     ("surface.wgsl", SURFACE),
     ("bsdf.wgsl", BSDF),
+    ("lights.wgsl", LIGHTS),
     ("integrator.wgsl", INTEGRATOR),
 ];
 
@@ -38,7 +41,7 @@ pub fn ray_query_library() -> String {
 /// The full integrator module.
 pub fn integrator_module() -> String {
     [
-        SCENE, INTERSECT, BVH, RNG, SAMPLING, SURFACE, BSDF, INTEGRATOR,
+        SCENE, INTERSECT, BVH, SAMPLER, SAMPLING, SURFACE, BSDF, LIGHTS, INTEGRATOR,
     ]
     .concat()
 }

@@ -6,7 +6,8 @@ use std::mem::{offset_of, size_of};
 
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use pathlight_core::gpu::{
-    GpuAccumPixel, GpuBvhNode, GpuFrameParams, GpuMaterial, GpuObject, GpuTextureInfo, GpuVertex,
+    GpuAccumPixel, GpuBvhNode, GpuFrameParams, GpuLight, GpuMaterial, GpuObject, GpuTextureInfo,
+    GpuVertex,
 };
 use pathlight_render::shaders;
 
@@ -80,8 +81,20 @@ fn host_structs_match_their_wgsl_declarations() {
         m,
         "Object",
         GpuObject,
-        [a, b, c, kind, material, blas_root, id, flags]
+        [
+            a,
+            b,
+            c,
+            kind,
+            material,
+            blas_root,
+            id,
+            flags,
+            light,
+            first_triangle
+        ]
     );
+    assert_layout!(m, "Light", GpuLight, [object, primitive, cdf, pmf]);
     assert_layout!(
         m,
         "BvhNode",
@@ -128,7 +141,11 @@ fn host_structs_match_their_wgsl_declarations() {
             rr_depth,
             seed,
             object_count,
-            row_offset
+            row_offset,
+            light_count,
+            env_pmf,
+            sampler,
+            row_end
         ]
     );
     assert_layout!(m, "AccumPixel", GpuAccumPixel, [hi, lo]);

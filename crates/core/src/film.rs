@@ -1,0 +1,110 @@
+//! The rendered image: mean linear radiance per pixel.
+
+/// Mean linear RGB radiance per pixel, row 0 at the top.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Film {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Samples per pixel averaged into every pixel.
+    pub spp: u32,
+    /// Row-major pixels.
+    pub pixels: Vec<[f32; 3]>,
+}
+
+impl Film {
+    /// The pixel at column `x`, row `y`.
+    pub fn pixel(&self, x: u32, y: u32) -> [f32; 3] {
+        self.pixels[(y * self.width + x) as usize]
+    }
+
+    /// Mean of every channel over the whole image (in f64).
+    pub fn mean(&self) -> [f64; 3] {
+        let mut sum = [0.0f64; 3];
+        for p in &self.pixels {
+            for c in 0..3 {
+                sum[c] += f64::from(p[c]);
+            }
+        }
+        sum.map(|s| s / self.pixels.len().max(1) as f64)
+    }
+}
+
+impl Film {
+    /// Reads a linear RGB OpenEXR file (`spp` is unknown and set to 0).
+    pub fn read_exr(path: &std::path::Path) -> Result<Self, exr::error::Error> {
+        use exr::prelude::*;
+        let image = read_first_rgba_layer_from_file(
+            path,
+            |resolution, _| {
+                let (w, h) = (resolution.width(), resolution.height());
+                (w, vec![[0.0f32; 3]; w * h])
+            },
+            |(width, pixels), position, (r, g, b, _a): (f32, f32, f32, f32)| {
+                pixels[position.y() * *width + position.x()] = [r, g, b];
+            },
+        )?;
+        let size = image.layer_data.size;
+        Ok(Self {
+            width: size.width() as u32,
+            height: size.height() as u32,
+            spp: 0,
+            pixels: image.layer_data.channel_data.pixels.1,
+        })
+    }
+
+    /// Writes the film as 32-bit float linear RGB OpenEXR.
+    pub fn write_exr(&self, path: &std::path::Path) -> Result<(), exr::error::Error> {
+        let width = self.width as usize;
+        exr::prelude::write_rgb_file(path, width, self.height as usize, |x, y| {
+            let [r, g, b] = self.pixels[y * width + x];
+            (r, g, b)
+        })
+    }
+
+    /// Box-downsamples by an integer `factor` (each output pixel is the mean of a
+    /// `factor` x `factor` block; a box-filtered render at the smaller size has this mean).
+    pub fn downsample(&self, factor: u32) -> Self {
+        let (w, h) = (self.width / factor, self.height / factor);
+        let mut pixels = vec![[0.0f32; 3]; (w * h) as usize];
+        for y in 0..h {
+            for x in 0..w {
+                let mut sum = [0.0f64; 3];
+                for dy in 0..factor {
+                    for dx in 0..factor {
+                        let p = self.pixel(x * factor + dx, y * factor + dy);
+                        for c in 0..3 {
+                            sum[c] += f64::from(p[c]);
+                        }
+                    }
+                }
+                let n = f64::from(factor * factor);
+                pixels[(y * w + x) as usize] = sum.map(|s| (s / n) as f32);
+            }
+        }
+        Self {
+            width: w,
+            height: h,
+            spp: self.spp,
+            pixels,
+        }
+    }
+
+    /// Relative mean squared error against `reference` of the same size:
+    /// mean over pixels and channels of (self - ref)^2 / (ref^2 + 0.01).
+    pub fn relmse(&self, reference: &Film) -> f64 {
+        assert_eq!(
+            (self.width, self.height),
+            (reference.width, reference.height)
+        );
+        let mut sum = 0.0f64;
+        for (p, r) in self.pixels.iter().zip(&reference.pixels) {
+            for c in 0..3 {
+                let (t, r) = (f64::from(p[c]), f64::from(r[c]));
+                sum += (t - r) * (t - r) / (r * r + 0.01);
+            }
+        }
+        sum / (3 * self.pixels.len()) as f64
+    }
+}

@@ -1,0 +1,430 @@
+//! The material model. Twin of `bsdf.wgsl`.
+//!
+//! A mixture of lobes with the seed's weights: Lambert (`1 - specular_rate - refract_rate`),
+//! specular reflection (`specular_rate`) and transmission (`refract_rate`). The specular lobe
+//! is a smooth mirror or a GGX microfacet conductor (Fresnel from a complex IOR, or Schlick
+//! from the specular colour); transmission is a smooth or GGX-rough dielectric (Walter et
+//! al. 2007, in pbrt-v4's formulation) with exact Fresnel. GGX uses Mitsuba 3's separable
+//! Smith term G1(wo) G1(wi), alpha = roughness^2, and visible-normal sampling (Heitz 2018).
+//! Lobes with alpha below [`ALPHA_MIN`] are smooth (delta) lobes.
+//!
+//! `eval` returns the non-delta part: `f * |cos_i|` and the density with which `sample`
+//! produces `wi` (its lobe's weight times the lobe's pdf, summed over non-delta lobes).
+//! `sample` picks a lobe with probability equal to its weight; a non-delta sample returns
+//! `eval / pdf` of the whole mixture (one-sample MIS over the lobes).
+
+use std::f32::consts::{FRAC_1_PI, PI};
+
+use glam::{Vec2, Vec3};
+use pathlight_core::gpu::GpuMaterial;
+
+use crate::sampling::{Frame, sample_cosine_hemisphere};
+use crate::surface::Surface;
+
+/// GGX alpha below which a lobe is treated as perfectly smooth.
+pub const ALPHA_MIN: f32 = 1e-3;
+
+/// The continuous part of the BSDF in one direction. Twin of WGSL `BsdfEval`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BsdfEval {
+    /// `f * |cos(wi, ns)|`.
+    pub f: Vec3,
+    /// Density of `sample` producing `wi` (solid angle).
+    pub pdf: f32,
+}
+
+/// A sampled direction. Twin of WGSL `BsdfSample`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BsdfSample {
+    /// Incident direction (unit, pointing away from the surface).
+    pub wi: Vec3,
+    /// `f * |cos| / pdf` (for a delta lobe: its reflectance or transmittance).
+    pub weight: Vec3,
+    /// Solid-angle density of the whole mixture at `wi`; 0 for a delta lobe.
+    pub pdf: f32,
+    /// Sampled from a delta lobe (no next-event estimation or MIS applies).
+    pub delta: bool,
+    /// Relative IOR n_transmitted / n_incident crossed by a refraction, else 1 (Russian
+    /// roulette undoes the 1/eta^2 radiance scaling with it, as Mitsuba does).
+    pub eta: f32,
+    /// False when no direction could be produced.
+    pub valid: bool,
+}
+
+const INVALID: BsdfSample = BsdfSample {
+    wi: Vec3::ZERO,
+    weight: Vec3::ZERO,
+    pdf: 0.0,
+    delta: false,
+    eta: 1.0,
+    valid: false,
+};
+
+/// Unpolarised dielectric Fresnel reflectance; `eta` = n_transmitted / n_incident, `cos_i`
+/// >= 0. Twin of WGSL `fresnel_dielectric`.
+pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// Unpolarised conductor Fresnel reflectance for IOR eta + i k (Mitsuba 3's
+/// `fresnel_conductor`). Twin of WGSL `fresnel_conductor`.
+pub fn fresnel_conductor(cos_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
+    let cos2 = cos_i * cos_i;
+    let sin2 = 1.0 - cos2;
+    let eta2 = eta * eta;
+    let k2 = k * k;
+    let t0 = eta2 - k2 - sin2;
+    let a2pb2 = (t0 * t0 + 4.0 * eta2 * k2).max(Vec3::ZERO).powf(0.5);
+    let a = (0.5 * (a2pb2 + t0)).max(Vec3::ZERO).powf(0.5);
+    let t1 = a2pb2 + cos2;
+    let t2 = 2.0 * cos_i * a;
+    let rs = (t1 - t2) / (t1 + t2).max(Vec3::splat(1e-20));
+    let t3 = cos2 * a2pb2 + sin2 * sin2;
+    let t4 = t2 * sin2;
+    let rp = rs * (t3 - t4) / (t3 + t4).max(Vec3::splat(1e-20));
+    0.5 * (rp + rs)
+}
+
+/// Reflectance of the specular lobe at `cos_i`. Twin of WGSL `specular_reflectance`.
+fn specular_reflectance(m: &GpuMaterial, color: Vec3, cos_i: f32) -> Vec3 {
+    if m.conductor != 0 {
+        return fresnel_conductor(cos_i, Vec3::from(m.eta), Vec3::from(m.k));
+    }
+    let f0 = Vec3::ONE.lerp(color, m.specular_tint);
+    f0 + (1.0 - f0) * (1.0 - cos_i.clamp(0.0, 1.0)).powi(5)
+}
+
+/// GGX normal distribution, local `m`. Twin of WGSL `ggx_d`.
+pub fn ggx_d(m: Vec3, alpha: f32) -> f32 {
+    let a2 = alpha * alpha;
+    let t = (m.x * m.x + m.y * m.y) / a2 + m.z * m.z;
+    1.0 / (PI * a2 * t * t)
+}
+
+/// Smith masking of one direction (either hemisphere). Twin of WGSL `ggx_g1`.
+pub fn ggx_g1(w: Vec3, alpha: f32) -> f32 {
+    let z2 = w.z * w.z;
+    if z2 <= 0.0 {
+        return 0.0;
+    }
+    let tan2 = (w.x * w.x + w.y * w.y) / z2;
+    2.0 / (1.0 + (1.0 + alpha * alpha * tan2).sqrt())
+}
+
+/// A GGX normal visible from `wo` (flipped into the upper hemisphere), Heitz 2018.
+/// Twin of WGSL `ggx_sample_visible`.
+pub fn ggx_sample_visible(wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
+    let w = if wo.z < 0.0 { -wo } else { wo };
+    let vh = Vec3::new(alpha * w.x, alpha * w.y, w.z).normalize();
+    let len2 = vh.x * vh.x + vh.y * vh.y;
+    let t1 = if len2 > 0.0 {
+        Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt()
+    } else {
+        Vec3::X
+    };
+    let t2 = vh.cross(t1);
+    let r = u.x.sqrt();
+    let phi = 2.0 * PI * u.y;
+    let p1 = r * phi.cos();
+    let s = 0.5 * (1.0 + vh.z);
+    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
+    let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
+    Vec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(1e-7)).normalize()
+}
+
+/// Density of `ggx_sample_visible` producing `m`. Twin of WGSL `ggx_pdf_visible`.
+fn ggx_pdf_visible(wo: Vec3, m: Vec3, alpha: f32) -> f32 {
+    ggx_g1(wo, alpha) * wo.dot(m).abs() * ggx_d(m, alpha) / wo.z.abs()
+}
+
+/// Lobe weights (diffuse, specular, transmission). Twin of WGSL `lobe_weights`.
+fn lobe_weights(m: &GpuMaterial) -> Vec3 {
+    Vec3::new(
+        (1.0 - m.specular_rate - m.refract_rate).max(0.0),
+        m.specular_rate,
+        m.refract_rate,
+    )
+}
+
+/// Dielectric Fresnel for local `wo` and microfacet `m` with the inside IOR `ior`
+/// (either side). Twin of WGSL `fresnel_dielectric_local`.
+fn fresnel_dielectric_local(cos_om: f32, ior: f32) -> f32 {
+    if cos_om >= 0.0 {
+        fresnel_dielectric(cos_om, ior)
+    } else {
+        fresnel_dielectric(-cos_om, 1.0 / ior)
+    }
+}
+
+/// The continuous part of the BSDF. Twin of WGSL `eval_bsdf`.
+pub fn eval_bsdf(m: &GpuMaterial, color: Vec3, s: &Surface, wo: Vec3, wi: Vec3) -> BsdfEval {
+    let weights = lobe_weights(m);
+    let front = wo.dot(s.ng) >= 0.0;
+    let sign = if front { 1.0 } else { -1.0 };
+    let ng = s.ng * sign;
+    let n = s.ns * sign;
+    let mut out = BsdfEval {
+        f: Vec3::ZERO,
+        pdf: 0.0,
+    };
+    let same_side = wi.dot(ng) > 0.0;
+    let cos_o = wo.dot(n);
+    let cos_i = wi.dot(n);
+    if same_side && cos_o > 0.0 && cos_i > 0.0 {
+        if weights.x > 0.0 {
+            out.f += weights.x * color * FRAC_1_PI * cos_i;
+            out.pdf += weights.x * FRAC_1_PI * cos_i;
+        }
+        let alpha = m.specular_roughness * m.specular_roughness;
+        if weights.y > 0.0 && alpha >= ALPHA_MIN {
+            let frame = Frame::around(n);
+            let (wo_l, wi_l) = (frame.to_local(wo), frame.to_local(wi));
+            let h = (wo_l + wi_l).normalize();
+            let f = specular_reflectance(m, color, wo_l.dot(h));
+            let d = ggx_d(h, alpha);
+            let g1o = ggx_g1(wo_l, alpha);
+            out.f += weights.y * f * d * g1o * ggx_g1(wi_l, alpha) / (4.0 * wo_l.z);
+            out.pdf += weights.y * g1o * d / (4.0 * wo_l.z);
+        }
+    }
+    let alpha_t = m.refract_roughness * m.refract_roughness;
+    if weights.z > 0.0 && alpha_t >= ALPHA_MIN {
+        let e = eval_rough_dielectric(m, color, s, wo, wi, alpha_t);
+        out.f += weights.z * e.f;
+        out.pdf += weights.z * e.pdf;
+    }
+    out
+}
+
+/// Rough dielectric (pbrt-v4 `DielectricBxDF::f` and `PDF`, separable Smith) in the frame
+/// of the outward shading normal. Twin of WGSL `eval_rough_dielectric`.
+fn eval_rough_dielectric(
+    m: &GpuMaterial,
+    color: Vec3,
+    s: &Surface,
+    wo: Vec3,
+    wi: Vec3,
+    alpha: f32,
+) -> BsdfEval {
+    let none = BsdfEval {
+        f: Vec3::ZERO,
+        pdf: 0.0,
+    };
+    let frame = Frame::around(s.ns);
+    let (wo_l, wi_l) = (frame.to_local(wo), frame.to_local(wi));
+    let (cos_o, cos_i) = (wo_l.z, wi_l.z);
+    // The geometric normal decides which side each direction is on.
+    let geo_reflect = (wo.dot(s.ng) >= 0.0) == (wi.dot(s.ng) >= 0.0);
+    let reflect = cos_o * cos_i > 0.0;
+    if cos_o == 0.0 || cos_i == 0.0 || reflect != geo_reflect {
+        return none;
+    }
+    let etap = if reflect {
+        1.0
+    } else if cos_o > 0.0 {
+        m.ior
+    } else {
+        1.0 / m.ior
+    };
+    let mut h = wi_l * etap + wo_l;
+    if h.length_squared() == 0.0 {
+        return none;
+    }
+    h = h.normalize();
+    if h.z < 0.0 {
+        h = -h;
+    }
+    if h.dot(wi_l) * cos_i < 0.0 || h.dot(wo_l) * cos_o < 0.0 {
+        return none;
+    }
+    let fr = fresnel_dielectric_local(wo_l.dot(h), m.ior);
+    let d = ggx_d(h, alpha);
+    let g = ggx_g1(wo_l, alpha) * ggx_g1(wi_l, alpha);
+    let pdf_h = ggx_pdf_visible(wo_l, h, alpha);
+    if reflect {
+        BsdfEval {
+            f: Vec3::splat(d * g * fr / (4.0 * cos_o.abs())),
+            pdf: pdf_h / (4.0 * wo_l.dot(h).abs()) * fr,
+        }
+    } else {
+        let denom = (wi_l.dot(h) + wo_l.dot(h) / etap).powi(2);
+        let tint = Vec3::ONE.lerp(color, m.refract_tint);
+        let ft = (1.0 - fr) * d * g * (wi_l.dot(h) * wo_l.dot(h)).abs()
+            / (cos_o.abs() * denom)
+            / (etap * etap);
+        BsdfEval {
+            f: tint * ft,
+            pdf: pdf_h * wi_l.dot(h).abs() / denom * (1.0 - fr),
+        }
+    }
+}
+
+/// `f / pdf` of the whole mixture at a sampled non-delta `wi`. Twin of WGSL `mixture_sample`.
+fn mixture_sample(m: &GpuMaterial, color: Vec3, s: &Surface, wo: Vec3, wi: Vec3) -> BsdfSample {
+    let e = eval_bsdf(m, color, s, wo, wi);
+    if e.pdf <= 0.0 || !e.pdf.is_finite() {
+        return INVALID;
+    }
+    // A direction on the other side of the geometric surface crossed the dielectric.
+    let eta = if (wo.dot(s.ng) >= 0.0) == (wi.dot(s.ng) >= 0.0) {
+        1.0
+    } else if wo.dot(s.ng) >= 0.0 {
+        m.ior
+    } else {
+        1.0 / m.ior
+    };
+    BsdfSample {
+        wi,
+        weight: e.f / e.pdf,
+        pdf: e.pdf,
+        delta: false,
+        eta,
+        valid: true,
+    }
+}
+
+/// Samples an incident direction. Twin of WGSL `sample_bsdf`.
+pub fn sample_bsdf(
+    m: &GpuMaterial,
+    color: Vec3,
+    s: &Surface,
+    wo: Vec3,
+    u_lobe: f32,
+    u_fresnel: f32,
+    u: Vec2,
+) -> BsdfSample {
+    let weights = lobe_weights(m);
+    let front = wo.dot(s.ng) >= 0.0;
+    let sign = if front { 1.0 } else { -1.0 };
+    let ng = s.ng * sign;
+    let n = s.ns * sign;
+    let cos_o = wo.dot(n);
+    if u_lobe < weights.y {
+        if cos_o <= 0.0 {
+            return INVALID;
+        }
+        let alpha = m.specular_roughness * m.specular_roughness;
+        if alpha < ALPHA_MIN {
+            let wi = 2.0 * cos_o * n - wo;
+            if wi.dot(ng) <= 0.0 {
+                return INVALID;
+            }
+            let weight = specular_reflectance(m, color, cos_o);
+            return BsdfSample {
+                wi,
+                weight,
+                pdf: 0.0,
+                delta: true,
+                eta: 1.0,
+                valid: true,
+            };
+        }
+        let frame = Frame::around(n);
+        let wo_l = frame.to_local(wo);
+        let h = ggx_sample_visible(wo_l, alpha, u);
+        let wi_l = 2.0 * wo_l.dot(h) * h - wo_l;
+        if wi_l.z <= 0.0 {
+            return INVALID;
+        }
+        return mixture_sample(m, color, s, wo, frame.to_world(wi_l));
+    }
+    if u_lobe < weights.y + weights.z {
+        let alpha = m.refract_roughness * m.refract_roughness;
+        if alpha < ALPHA_MIN {
+            return sample_smooth_dielectric(m, color, s, wo, u_fresnel);
+        }
+        let frame = Frame::around(s.ns);
+        let wo_l = frame.to_local(wo);
+        if wo_l.z == 0.0 {
+            return INVALID;
+        }
+        let h = ggx_sample_visible(wo_l, alpha, u);
+        let cos_oh = wo_l.dot(h);
+        let fr = fresnel_dielectric_local(cos_oh, m.ior);
+        let wi_l = if u_fresnel < fr {
+            2.0 * cos_oh * h - wo_l
+        } else {
+            // Refract wo through h: relative IOR seen from wo's side.
+            let (eta, hf, c) = if cos_oh >= 0.0 {
+                (m.ior, h, cos_oh)
+            } else {
+                (1.0 / m.ior, -h, -cos_oh)
+            };
+            let sin2_t = (1.0 - c * c) / (eta * eta);
+            if sin2_t >= 1.0 {
+                return INVALID;
+            }
+            -wo_l / eta + (c / eta - (1.0 - sin2_t).sqrt()) * hf
+        };
+        return mixture_sample(m, color, s, wo, frame.to_world(wi_l));
+    }
+    if cos_o <= 0.0 {
+        return INVALID;
+    }
+    let wi = Frame::around(n).to_world(sample_cosine_hemisphere(u));
+    if wi.dot(ng) <= 0.0 {
+        return INVALID;
+    }
+    mixture_sample(m, color, s, wo, wi)
+}
+
+/// Smooth dielectric: reflect with probability F, else refract; radiance scaled by
+/// 1/eta^2 on refraction (as Mitsuba and pbrt do). Twin of WGSL `sample_smooth_dielectric`.
+fn sample_smooth_dielectric(
+    m: &GpuMaterial,
+    color: Vec3,
+    s: &Surface,
+    wo: Vec3,
+    u_fresnel: f32,
+) -> BsdfSample {
+    let front = wo.dot(s.ng) >= 0.0;
+    let sign = if front { 1.0 } else { -1.0 };
+    let ng = s.ng * sign;
+    let n = s.ns * sign;
+    let cos_o = wo.dot(n);
+    if cos_o <= 0.0 {
+        return INVALID;
+    }
+    let eta = if front { m.ior } else { 1.0 / m.ior };
+    let f = fresnel_dielectric(cos_o, eta);
+    if u_fresnel < f {
+        let wi = 2.0 * cos_o * n - wo;
+        let valid = wi.dot(ng) > 0.0;
+        return BsdfSample {
+            wi,
+            weight: Vec3::ONE,
+            pdf: 0.0,
+            delta: true,
+            eta: 1.0,
+            valid,
+        };
+    }
+    let sin2_t = (1.0 - cos_o * cos_o) / (eta * eta);
+    let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
+    let wi = -wo / eta + (cos_o / eta - cos_t) * n;
+    let weight = Vec3::ONE.lerp(color, m.refract_tint) / (eta * eta);
+    BsdfSample {
+        wi,
+        weight,
+        pdf: 0.0,
+        delta: true,
+        eta,
+        valid: wi.dot(ng) < 0.0,
+    }
+}
+
+/// Whether the material has a non-delta lobe (next-event estimation is worth doing).
+/// Twin of WGSL `has_continuous_lobe`.
+pub fn has_continuous_lobe(m: &GpuMaterial) -> bool {
+    let w = lobe_weights(m);
+    w.x > 0.0
+        || (w.y > 0.0 && m.specular_roughness * m.specular_roughness >= ALPHA_MIN)
+        || (w.z > 0.0 && m.refract_roughness * m.refract_roughness >= ALPHA_MIN)
+}

@@ -1,0 +1,104 @@
+//! pathlight's native CPU backend: the WGSL integrator's twin in Rust over the same scene
+//! buffers ([`pathlight_core::GpuScene`]), parallel over rows with rayon. Every function
+//! names its WGSL twin; the tests render scenes on both backends and compare.
+
+pub mod bsdf;
+pub mod integrator;
+pub mod lights;
+pub mod sampler;
+pub mod sampling;
+pub mod surface;
+
+use std::time::{Duration, Instant};
+
+use pathlight_core::frame::frame_params;
+use pathlight_core::gpu::GpuFrameParams;
+use pathlight_core::{Film, GpuScene, Scene};
+use rayon::prelude::*;
+
+use crate::integrator::{accumulated_value, camera_ray, trace_path};
+use crate::sampler::Sampler;
+
+/// Aimed-for duration of one `advance` (for progress reports and interruption).
+const TARGET_BATCH: Duration = Duration::from_millis(250);
+
+/// A progressive render on the CPU.
+#[derive(Debug)]
+pub struct CpuRenderer {
+    scene: GpuScene,
+    params: GpuFrameParams,
+    /// Per pixel, the sum of accumulated samples (f64: exact enough for any sample count).
+    sums: Vec<[f64; 3]>,
+    samples_done: u32,
+    batch_samples: u32,
+}
+
+impl CpuRenderer {
+    /// Prepares `scene`; the image starts empty.
+    pub fn new(scene: &Scene, gpu_scene: GpuScene) -> Self {
+        let params = frame_params(scene, &gpu_scene);
+        let pixels = (params.width * params.height) as usize;
+        Self {
+            scene: gpu_scene,
+            params,
+            sums: vec![[0.0; 3]; pixels],
+            samples_done: 0,
+            batch_samples: 1,
+        }
+    }
+
+    /// Samples per pixel accumulated so far.
+    pub fn samples_done(&self) -> u32 {
+        self.samples_done
+    }
+
+    /// Adds up to `max_samples` samples per pixel (at least one when `max_samples` > 0) in
+    /// about [`TARGET_BATCH`]; returns how many were added. Twin of the GPU renderer's
+    /// `advance`: the same samples of the same pixels give the same estimator.
+    pub fn advance(&mut self, max_samples: u32) -> u32 {
+        let samples = self.batch_samples.min(max_samples);
+        if samples == 0 {
+            return 0;
+        }
+        let started = Instant::now();
+        let (scene, params, offset) = (&self.scene, &self.params, self.samples_done);
+        let width = params.width as usize;
+        self.sums
+            .par_chunks_mut(width)
+            .enumerate()
+            .for_each(|(y, row)| {
+                for (x, sum) in row.iter_mut().enumerate() {
+                    let pixel = (y * width + x) as u32;
+                    for i in 0..samples {
+                        let mut sampler =
+                            Sampler::new(params.sampler, pixel, offset + i, params.seed);
+                        let ray = camera_ray(params, x as u32, y as u32, &mut sampler);
+                        let value = accumulated_value(trace_path(scene, params, ray, &mut sampler));
+                        for c in 0..3 {
+                            sum[c] += f64::from(value[c]);
+                        }
+                    }
+                }
+            });
+        self.samples_done += samples;
+        let per_sample = started.elapsed().as_secs_f64() / f64::from(samples);
+        self.batch_samples =
+            ((TARGET_BATCH.as_secs_f64() / per_sample.max(1e-9)) as u32).clamp(1, 1024);
+        samples
+    }
+
+    /// The mean of the samples so far.
+    pub fn film(&self) -> Film {
+        let scale = 1.0 / f64::from(self.samples_done.max(1));
+        Film {
+            width: self.params.width,
+            height: self.params.height,
+            spp: self.samples_done,
+            pixels: self
+                .sums
+                .iter()
+                .map(|s| s.map(|c| (c * scale) as f32))
+                .collect(),
+        }
+    }
+}

@@ -1,0 +1,232 @@
+//! Sample values for every dimension of a path. Twin of `sampler.wgsl`.
+//!
+//! Padded Owen-scrambled Sobol (Burley, "Practical Hash-based Owen Scrambling", JCGT 2020):
+//! every 1D or 2D request of a path gets its own dimension number; its values are the first
+//! two Sobol dimensions (a (0,2)-sequence) at a per-(pixel, dimension) shuffled index, each
+//! Owen-scrambled with its own seed (pbrt-v4's `PaddedSobolSampler` scheme). Each sample uses a fixed number of dimensions per bounce, so a dimension
+//! always serves the same purpose. The independent alternative is a PCG stream seeded by
+//! (pixel, sample, seed).
+
+use glam::Vec2;
+use pathlight_core::gpu::SAMPLER_SOBOL;
+
+/// PCG hash (Jarzynski and Olano, JCGT 2020). Twin of WGSL `pcg_hash`.
+pub fn pcg_hash(v: u32) -> u32 {
+    let state = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+    let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
+    (word >> 22) ^ word
+}
+
+/// Seed of `pixel` for `sample_index` under `seed`. Twin of WGSL `rng_init`.
+pub fn rng_init(pixel: u32, sample_index: u32, seed: u32) -> u32 {
+    pcg_hash(pixel ^ pcg_hash(sample_index ^ pcg_hash(seed)))
+}
+
+/// Owen scrambling of the bits of `x` from low to high (Laine and Karras 2011, Burley's
+/// constants). Twin of WGSL `laine_karras`.
+fn laine_karras(mut x: u32, seed: u32) -> u32 {
+    x = x.wrapping_add(seed);
+    x ^= x.wrapping_mul(0x6c50_b47c);
+    x ^= x.wrapping_mul(0xb82f_1e52);
+    x ^= x.wrapping_mul(0xc7af_e638);
+    x ^= x.wrapping_mul(0x8d22_f6e6);
+    x
+}
+
+/// Owen scrambling from high bits to low. Twin of WGSL `nested_uniform_scramble`.
+fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
+    laine_karras(x.reverse_bits(), seed).reverse_bits()
+}
+
+/// Sobol dimension 0 (van der Corput). Twin of WGSL `sobol_0`.
+fn sobol_0(index: u32) -> u32 {
+    index.reverse_bits()
+}
+
+/// Sobol dimension 1 (primitive polynomial x + 1): the generator matrix is the binary
+/// Pascal matrix, so by Lucas' theorem bit p of the result (from the top) is the XOR of the
+/// index bits k that are supersets of p: a superset-XOR transform, then reversed. Twin of
+/// WGSL `sobol_1`.
+fn sobol_1(index: u32) -> u32 {
+    let mut y = index;
+    y ^= (y >> 1) & 0x5555_5555;
+    y ^= (y >> 2) & 0x3333_3333;
+    y ^= (y >> 4) & 0x0f0f_0f0f;
+    y ^= (y >> 8) & 0x00ff_00ff;
+    y ^= (y >> 16) & 0x0000_ffff;
+    y.reverse_bits()
+}
+
+/// The top 24 bits of `x` as a float in [0, 1). Twin of WGSL `to_unit_float`.
+fn to_unit_float(x: u32) -> f32 {
+    (x >> 8) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// The sample values of one path. Twin of WGSL `Sampler`.
+#[derive(Debug, Clone)]
+pub struct Sampler {
+    kind: u32,
+    pixel_seed: u32,
+    index: u32,
+    dimension: u32,
+    rng_state: u32,
+}
+
+impl Sampler {
+    /// Sample `index` of `pixel` under `seed`, of kind `SAMPLER_*`. Twin of WGSL `sampler_init`.
+    pub fn new(kind: u32, pixel: u32, index: u32, seed: u32) -> Self {
+        Self {
+            kind,
+            pixel_seed: pcg_hash(pixel ^ pcg_hash(seed)),
+            index,
+            dimension: 0,
+            rng_state: rng_init(pixel, index, seed),
+        }
+    }
+
+    fn next_random(&mut self) -> f32 {
+        self.rng_state = self
+            .rng_state
+            .wrapping_mul(747_796_405)
+            .wrapping_add(2_891_336_453);
+        let s = self.rng_state;
+        let word = ((s >> ((s >> 28) + 4)) ^ s).wrapping_mul(277_803_737);
+        to_unit_float((word >> 22) ^ word)
+    }
+
+    fn dimension_seed(&mut self) -> u32 {
+        let seed = pcg_hash(self.pixel_seed ^ pcg_hash(self.dimension));
+        self.dimension += 1;
+        seed
+    }
+
+    /// The next value in [0, 1). Twin of WGSL `next_1d`.
+    pub fn next_1d(&mut self) -> f32 {
+        if self.kind != SAMPLER_SOBOL {
+            return self.next_random();
+        }
+        let seed = self.dimension_seed();
+        let index = nested_uniform_scramble(self.index, seed);
+        to_unit_float(nested_uniform_scramble(sobol_0(index), pcg_hash(seed ^ 1)))
+    }
+
+    /// The next point in [0, 1)^2, stratified with the other samples of the pixel. Twin of
+    /// WGSL `next_2d`.
+    pub fn next_2d(&mut self) -> Vec2 {
+        if self.kind != SAMPLER_SOBOL {
+            let x = self.next_random();
+            return Vec2::new(x, self.next_random());
+        }
+        let seed = self.dimension_seed();
+        let index = nested_uniform_scramble(self.index, seed);
+        Vec2::new(
+            to_unit_float(nested_uniform_scramble(sobol_0(index), pcg_hash(seed ^ 1))),
+            to_unit_float(nested_uniform_scramble(sobol_1(index), pcg_hash(seed ^ 2))),
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pathlight_core::gpu::SAMPLER_INDEPENDENT;
+
+    /// Dimension 1 from its direction numbers v_0 = 2^31, v_b = v_(b-1) ^ (v_(b-1) >> 1).
+    fn sobol_1_by_direction_numbers(index: u32) -> u32 {
+        let (mut x, mut v) = (0u32, 0x8000_0000u32);
+        for bit in 0..32 {
+            if (index >> bit) & 1 == 1 {
+                x ^= v;
+            }
+            v ^= v >> 1;
+        }
+        x
+    }
+
+    #[test]
+    fn pascal_transform_equals_direction_numbers() {
+        let mut state = 1u32;
+        for i in (0..4096).chain((0..4096).map(|_| {
+            state = pcg_hash(state);
+            state
+        })) {
+            assert_eq!(sobol_1(i), sobol_1_by_direction_numbers(i), "index {i:#x}");
+        }
+    }
+
+    #[test]
+    fn first_sobol_points_are_the_known_values() {
+        // Dimension 1 by binary (not Gray-code) index: 0, 1/2, 3/4, 1/4, 5/8, 1/8, 3/8, 7/8.
+        let expected = [0.0, 0.5, 0.75, 0.25, 0.625, 0.125, 0.375, 0.875];
+        for (i, e) in expected.iter().enumerate() {
+            assert_eq!(f64::from(sobol_1(i as u32)) / 4294967296.0, *e);
+            assert_eq!(sobol_0(i as u32), (i as u32).reverse_bits());
+        }
+    }
+
+    #[test]
+    fn the_two_dimensions_form_a_0_2_sequence() {
+        // Every block of 256 points has one point in each elementary interval of area
+        // 1/256: boxes of 2^-a x 2^-(8-a) for a = 0..=8.
+        for block in 0..4u32 {
+            for a in 0..=8u32 {
+                let mut seen = [false; 256];
+                for i in block * 256..(block + 1) * 256 {
+                    let x = if a == 0 { 0 } else { sobol_0(i) >> (32 - a) };
+                    let y = if a == 8 { 0 } else { sobol_1(i) >> (24 + a) };
+                    seen[((x << (8 - a)) | y) as usize] = true;
+                }
+                assert!(
+                    seen.iter().all(|s| *s),
+                    "block {block}, boxes 2^-{a} x 2^-{}",
+                    8 - a
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn sobol_2d_samples_of_a_pixel_are_stratified() {
+        // 256 samples of one pixel, second 2D dimension: one point per cell of 16 x 16.
+        let mut seen = [false; 256];
+        for i in 0..256 {
+            let mut s = Sampler::new(SAMPLER_SOBOL, 1234, i, 7);
+            s.next_2d();
+            let p = s.next_2d();
+            seen[(p.y * 16.0) as usize * 16 + (p.x * 16.0) as usize] = true;
+        }
+        assert!(seen.iter().all(|s| *s));
+    }
+
+    #[test]
+    fn values_are_uniform_and_decorrelated_across_pixels() {
+        // Mean and variance of 4096 values (64 pixels x 64 samples) per dimension:
+        // 1/2 and 1/12 within 4 standard errors; the pixels differ from each other.
+        for kind in [SAMPLER_SOBOL, SAMPLER_INDEPENDENT] {
+            for dim in 0..6 {
+                let mut values = Vec::new();
+                for pixel in 0..64 {
+                    for i in 0..64 {
+                        let mut s = Sampler::new(kind, pixel, i, 3);
+                        for _ in 0..dim {
+                            s.next_1d();
+                        }
+                        values.push(f64::from(s.next_1d()));
+                    }
+                }
+                let n = values.len() as f64;
+                let mean = values.iter().sum::<f64>() / n;
+                let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
+                assert!(
+                    (mean - 0.5).abs() < 4.0 * (1.0 / 12.0f64 / n).sqrt(),
+                    "kind {kind} dim {dim}: mean {mean}"
+                );
+                assert!(
+                    (var - 1.0 / 12.0).abs() < 0.01,
+                    "kind {kind} dim {dim}: variance {var}"
+                );
+                assert_ne!(values[0..64], values[64..128]);
+            }
+        }
+    }
+}

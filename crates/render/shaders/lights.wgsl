@@ -1,0 +1,196 @@
+// Next-event estimation: choosing a light and a point on it, and the density of doing so.
+// CPU twin: `crates/cpu/src/lights.rs`. The environment is chosen with probability
+// env_pmf, directions cosine-weighted about the shading normal; otherwise a shape light by
+// power from `lights`. Quads,
+// cylinders and triangles are sampled by area, spheres by solid angle from outside.
+
+struct LightSample {
+    wi: vec3f,
+    // The point on the light (unused for the environment).
+    point: vec3f,
+    // False for the environment.
+    finite: bool,
+    radiance: vec3f,
+    // Solid-angle density including the choice of the light.
+    pdf: f32,
+    valid: bool,
+}
+
+fn invalid_light_sample() -> LightSample {
+    return LightSample(vec3f(0.0), vec3f(0.0), false, vec3f(0.0), 0.0, false);
+}
+
+// n: the normal on the side light is gathered from.
+fn env_pdf(n: vec3f, wi: vec3f) -> f32 {
+    return params.env_pmf * max(0.0, dot(n, wi)) / PI;
+}
+
+fn cylinder_area(o: Object) -> f32 {
+    let r = o.a.w;
+    let h = length(o.b.xyz - o.a.xyz);
+    let caps = select(0.0, 2.0 * PI * r * r, (o.flags & FLAG_CAPS) != 0u);
+    return TAU * r * h + caps;
+}
+
+// 1 - cos of the half-angle of the cone a sphere subtends from p; negative inside it.
+fn sphere_cone(center: vec3f, radius: f32, p: vec3f) -> f32 {
+    let d = center - p;
+    let d2 = dot(d, d);
+    let r2 = radius * radius;
+    if d2 <= r2 * 1.0001 {
+        return -1.0;
+    }
+    let sin2_max = r2 / d2;
+    let cos_max = sqrt(max(0.0, 1.0 - sin2_max));
+    return sin2_max / (1.0 + cos_max);
+}
+
+fn light_pdf(object: u32, primitive: u32, p: vec3f, p_light: vec3f, n_light: vec3f) -> f32 {
+    let o = objects[object];
+    var entry = o.light;
+    if o.kind == KIND_MESH {
+        entry = o.light + primitive - o.first_triangle;
+    }
+    let pmf = lights[entry].pmf * (1.0 - params.env_pmf);
+    let to_light = p_light - p;
+    let d2 = dot(to_light, to_light);
+    let cos_l = abs(dot(n_light, -to_light)) / sqrt(d2);
+    var area: f32;
+    switch o.kind {
+        case KIND_QUAD: {
+            area = length(cross(o.b.xyz, o.c.xyz));
+        }
+        case KIND_SPHERE: {
+            let one_minus_cos = sphere_cone(o.a.xyz, o.a.w, p);
+            if one_minus_cos > 0.0 {
+                return pmf / (TAU * one_minus_cos);
+            }
+            area = 4.0 * PI * o.a.w * o.a.w;
+        }
+        case KIND_CYLINDER: {
+            area = cylinder_area(o);
+        }
+        default: {
+            let i = 3u * primitive;
+            let v0 = vertices[i].position;
+            area = 0.5 * length(cross(vertices[i + 1u].position - v0, vertices[i + 2u].position - v0));
+        }
+    }
+    if cos_l <= 0.0 || area <= 0.0 {
+        return 0.0;
+    }
+    return pmf * d2 / (cos_l * area);
+}
+
+// A point on a shape: point, normal, and its area density (a negative value: the
+// solid-angle density of a sphere's cone sample).
+struct ShapeSample {
+    point: vec3f,
+    normal: vec3f,
+    density: f32,
+}
+
+fn sample_shape(o: Object, primitive: u32, p: vec3f, u: vec2f, u_part: f32) -> ShapeSample {
+    let a = o.a.xyz;
+    let b = o.b.xyz;
+    let c = o.c.xyz;
+    switch o.kind {
+        case KIND_QUAD: {
+            let n = cross(b, c);
+            return ShapeSample(a + u.x * b + u.y * c, normalize(n), 1.0 / length(n));
+        }
+        case KIND_SPHERE: {
+            let radius = o.a.w;
+            let one_minus_cos = sphere_cone(a, radius, p);
+            if one_minus_cos > 0.0 {
+                let cos_theta = 1.0 - u.x * one_minus_cos;
+                let sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
+                let phi = TAU * u.y;
+                let dir = frame_around(normalize(a - p)) * vec3f(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
+                var t = intersect_sphere(a, radius, Ray(p, dir), 1e30);
+                if t == MISS {
+                    t = dot(a - p, dir);
+                }
+                let q = p + t * dir;
+                return ShapeSample(q, normalize(q - a), -1.0 / (TAU * one_minus_cos));
+            }
+            let n = sample_uniform_sphere(u);
+            return ShapeSample(a + radius * n, n, 1.0 / (4.0 * PI * radius * radius));
+        }
+        case KIND_CYLINDER: {
+            let radius = o.a.w;
+            let axis_full = b - a;
+            let height = length(axis_full);
+            let axis = axis_full / height;
+            let frame = frame_around(axis);
+            let area = cylinder_area(o);
+            let side = TAU * radius * height;
+            if u_part * area < side || (o.flags & FLAG_CAPS) == 0u {
+                let phi = TAU * u.x;
+                let radial = frame[0] * cos(phi) + frame[1] * sin(phi);
+                return ShapeSample(a + axis * (u.y * height) + radial * radius, radial, 1.0 / area);
+            }
+            let top = u_part * area >= side + 0.5 * (area - side);
+            let d = sample_disk(u) * radius;
+            let center = select(a, b, top);
+            return ShapeSample(center + frame[0] * d.x + frame[1] * d.y, select(-axis, axis, top), 1.0 / area);
+        }
+        default: {
+            let i = 3u * primitive;
+            let v0 = vertices[i].position;
+            let v1 = vertices[i + 1u].position;
+            let v2 = vertices[i + 2u].position;
+            let su = sqrt(u.x);
+            let b1 = 1.0 - su;
+            let b2 = u.y * su;
+            let n = cross(v1 - v0, v2 - v0);
+            return ShapeSample(v0 + b1 * (v1 - v0) + b2 * (v2 - v0), normalize(n), 2.0 / length(n));
+        }
+    }
+}
+
+fn sample_light(p: vec3f, n: vec3f, u_select: f32, u: vec2f) -> LightSample {
+    if u_select < params.env_pmf {
+        let wi = frame_around(n) * sample_cosine_hemisphere(u);
+        let pdf = env_pdf(n, wi);
+        return LightSample(wi, vec3f(0.0), false, params.environment, pdf, pdf > 0.0);
+    }
+    if params.light_count == 0u {
+        return invalid_light_sample();
+    }
+    let u_light = min((u_select - params.env_pmf) / (1.0 - params.env_pmf), 0.99999994);
+    var lo = 0u;
+    var hi = params.light_count - 1u;
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        if lights[mid].cdf > u_light {
+            hi = mid;
+        } else {
+            lo = mid + 1u;
+        }
+    }
+    let light = lights[lo];
+    let below = light.cdf - light.pmf;
+    let u_part = clamp((u_light - below) / max(light.pmf, 1e-30), 0.0, 1.0);
+    let o = objects[light.object];
+    let ss = sample_shape(o, light.primitive, p, u, u_part);
+    let to_light = ss.point - p;
+    let distance = length(to_light);
+    if distance <= 0.0 {
+        return invalid_light_sample();
+    }
+    let wi = to_light / distance;
+    let cos_l = dot(ss.normal, -wi);
+    if cos_l <= 0.0 {
+        return invalid_light_sample();
+    }
+    let pmf = light.pmf * (1.0 - params.env_pmf);
+    var pdf: f32;
+    if ss.density < 0.0 {
+        pdf = pmf * -ss.density;
+    } else {
+        pdf = pmf * ss.density * distance * distance / cos_l;
+    }
+    let radiance = materials[o.material].emission;
+    return LightSample(wi, ss.point, true, radiance, pdf, pdf > 0.0 && pdf <= 3.0e38);
+}
