@@ -137,26 +137,23 @@ pub struct MaterialDesc {
     pub texture: Option<String>,
     /// Emitted linear radiance (W m^-2 sr^-1), on the front side only.
     pub emission: Option<[f32; 3]>,
+    /// One of the seed's materials (`metal`, `plastic`, `wall`, `glass`, `wood`, `ceramic`)
+    /// giving defaults for the lobe parameters below.
+    pub preset: Option<String>,
     /// Weight of the specular reflection lobe.
     pub specular_rate: Option<f32>,
     /// Specular colour between white (0) and the base colour (1).
-    #[serde(default)]
-    pub specular_tint: f32,
-    /// Roughness of the specular lobe.
-    #[serde(default)]
-    pub specular_roughness: f32,
+    pub specular_tint: Option<f32>,
+    /// Roughness of the specular lobe (GGX alpha = roughness^2).
+    pub specular_roughness: Option<f32>,
     /// Weight of the transmission lobe.
-    #[serde(default)]
-    pub refract_rate: f32,
+    pub refract_rate: Option<f32>,
     /// Transmitted colour between white (0) and the base colour (1).
-    #[serde(default)]
-    pub refract_tint: f32,
+    pub refract_tint: Option<f32>,
     /// Index of refraction of the inside.
-    #[serde(default = "default_ior")]
-    pub ior: f32,
-    /// Roughness of transmission.
-    #[serde(default)]
-    pub refract_roughness: f32,
+    pub ior: Option<f32>,
+    /// Roughness of transmission (GGX alpha = roughness^2).
+    pub refract_roughness: Option<f32>,
     /// Conductor Fresnel for the specular lobe: a preset name (`"gold"`, `"aluminium"`, ...).
     pub conductor: Option<String>,
     /// Conductor Fresnel from a complex index of refraction: real part per RGB channel.
@@ -167,10 +164,6 @@ pub struct MaterialDesc {
 
 fn default_color() -> [f32; 3] {
     [0.8, 0.8, 0.8]
-}
-
-fn default_ior() -> f32 {
-    1.5
 }
 
 /// The parallelogram `origin + s edge_u + t edge_v`, s, t in [0, 1]; normal `edge_u x edge_v`.

@@ -12,8 +12,8 @@ use crate::error::SceneError;
 use crate::gpu::{SAMPLER_INDEPENDENT, SAMPLER_SOBOL};
 use crate::revolve::Revolution;
 use crate::scene::{
-    Camera, Conductor, MAX_DEPTH, MAX_RESOLUTION, MAX_SPP, Material, Object, RenderSettings, Scene,
-    Shape, Texture,
+    Camera, Conductor, Lobes, MAX_DEPTH, MAX_RESOLUTION, MAX_SPP, Material, Object, RenderSettings,
+    Scene, Shape, Texture,
 };
 use crate::texture::srgb_to_linear;
 
@@ -236,14 +236,32 @@ impl Builder<'_, '_> {
                 ));
             }
         };
+        let base = match &m.preset {
+            None => Lobes::DIFFUSE,
+            Some(name) => Lobes::preset(name).ok_or_else(|| {
+                let names: Vec<_> = Lobes::PRESETS.iter().map(|(n, _)| *n).collect();
+                self.invalid(
+                    span.clone(),
+                    format!("{} = {name:?} is not one of {names:?}", key("preset")),
+                )
+            })?,
+        };
         // A conductor is all specular unless the file says otherwise.
-        let default_specular = if conductor.is_some() { 1.0 } else { 0.0 };
+        let default_specular = if conductor.is_some() {
+            1.0
+        } else {
+            base.specular_rate
+        };
         let specular_rate = self.unit(
             span.clone(),
             &key("specular_rate"),
             m.specular_rate.unwrap_or(default_specular),
         )?;
-        let refract_rate = self.unit(span.clone(), &key("refract_rate"), m.refract_rate)?;
+        let refract_rate = self.unit(
+            span.clone(),
+            &key("refract_rate"),
+            m.refract_rate.unwrap_or(base.refract_rate),
+        )?;
         if specular_rate + refract_rate > 1.0 + 1e-6 {
             return Err(self.invalid(
                 span,
@@ -253,8 +271,9 @@ impl Builder<'_, '_> {
                 ),
             ));
         }
-        if !(m.ior.is_finite() && m.ior > 0.0) {
-            return Err(self.invalid(span, format!("{} = {} must be > 0", key("ior"), m.ior)));
+        let ior = m.ior.unwrap_or(base.ior);
+        if !(ior.is_finite() && ior > 0.0) {
+            return Err(self.invalid(span, format!("{} = {ior} must be > 0", key("ior"))));
         }
         let texture = match &m.texture {
             Some(path) => Some(self.texture(span.clone(), &key("texture"), path)?),
@@ -266,16 +285,28 @@ impl Builder<'_, '_> {
             texture,
             emission,
             specular_rate,
-            specular_tint: self.unit(span.clone(), &key("specular_tint"), m.specular_tint)?,
+            specular_tint: self.unit(
+                span.clone(),
+                &key("specular_tint"),
+                m.specular_tint.unwrap_or(base.specular_tint),
+            )?,
             specular_roughness: self.unit(
                 span.clone(),
                 &key("specular_roughness"),
-                m.specular_roughness,
+                m.specular_roughness.unwrap_or(base.specular_roughness),
             )?,
             refract_rate,
-            refract_tint: self.unit(span.clone(), &key("refract_tint"), m.refract_tint)?,
-            ior: m.ior,
-            refract_roughness: self.unit(span, &key("refract_roughness"), m.refract_roughness)?,
+            refract_tint: self.unit(
+                span.clone(),
+                &key("refract_tint"),
+                m.refract_tint.unwrap_or(base.refract_tint),
+            )?,
+            ior,
+            refract_roughness: self.unit(
+                span,
+                &key("refract_roughness"),
+                m.refract_roughness.unwrap_or(base.refract_roughness),
+            )?,
             conductor,
         })
     }

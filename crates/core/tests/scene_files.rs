@@ -48,7 +48,7 @@ fn shipped_scenes_load() {
             }
         }
     }
-    assert_eq!(found, 5, "default + four reference scenes");
+    assert_eq!(found, 6, "default + five reference scenes");
 }
 
 #[test]
@@ -173,6 +173,31 @@ fn out_of_range_material_parameters_are_refused() {
         assert!(message.starts_with("test.toml:6:"), "{body}: {message}");
         assert!(message.contains(needle), "{body}: {message}");
     }
+}
+
+#[test]
+fn seed_presets_give_defaults_that_keys_override() {
+    let scene = load(
+        "[materials.a]\npreset = \"metal\"\n[materials.b]\npreset = \"glass\"\nior = 1.33\n[materials.c]\npreset = \"ceramic\"\nspecular_rate = 0.5\n",
+    )
+    .unwrap();
+    let m = |name: &str| {
+        scene
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .unwrap()
+            .clone()
+    };
+    assert_eq!((m("a").specular_rate, m("a").specular_tint), (1.0, 1.0));
+    assert_eq!((m("b").refract_rate, m("b").ior), (1.0, 1.33));
+    assert_eq!(m("c").specular_rate, 0.5);
+    assert!(m("c").specular_roughness > 0.0);
+    let message = error("[materials.m]\npreset = \"marble\"\n");
+    assert!(
+        message.starts_with("test.toml:6:") && message.contains("ceramic"),
+        "{message}"
+    );
 }
 
 #[test]

@@ -40,27 +40,3 @@ pub fn render(scene: &Scene) -> Film {
     }
     renderer.read_film().unwrap()
 }
-
-/// Reads a linear RGB EXR as (width, height, pixels).
-pub fn read_exr(path: &Path) -> (usize, usize, Vec<[f32; 3]>) {
-    use exr::prelude::*;
-    let image = read_first_rgba_layer_from_file(
-        path,
-        |resolution, _| {
-            (
-                resolution.width(),
-                vec![[0.0f32; 3]; resolution.width() * resolution.height()],
-            )
-        },
-        |(width, pixels), position, (r, g, b, _a): (f32, f32, f32, f32)| {
-            pixels[position.y() * *width + position.x()] = [r, g, b];
-        },
-    )
-    .unwrap();
-    let size = image.layer_data.size;
-    (
-        size.width(),
-        size.height(),
-        image.layer_data.channel_data.pixels.1,
-    )
-}

@@ -1,5 +1,7 @@
 //! GPU tests on a real wgpu adapter (lavapipe on CI), one binary sharing one device.
 
 mod common;
+mod extreme;
 mod render;
 mod trace;
+mod twin;

@@ -2,7 +2,9 @@
 //! emitters seen directly, accumulation precision), a Mitsuba 3 reference, and the default
 //! scene. Images are small so the suite stays fast on the CPU adapter.
 
-use crate::common::{context, read_exr, render, repo, scene};
+use pathlight_core::Film;
+
+use crate::common::{context, render, repo, scene};
 use glam::Vec3;
 use pathlight_core::default_scene;
 
@@ -104,32 +106,30 @@ fn max_depth_one_shows_only_emitters() {
     );
 }
 
-/// cornell-diffuse against Mitsuba 3's converged image: the image mean per channel.
-/// Tolerance 2.5%: measured over seeds 0-7 at 64x64 and 32 spp, pathlight's mean ratio
-/// scatters with a standard deviation of about 0.6% (worst seed -1.8%; pure BSDF sampling
-/// of a small light), so this is about 4 sigma; a bias of a few percent (a wrong cosine,
-/// pdf or Fresnel) fails.
+/// cornell-diffuse against Mitsuba 3's converged image at 64x64, 64 spp (the CI size on
+/// lavapipe; the CPU twin carries every reference scene at 128x128): the image mean within
+/// 0.5% per channel, and relMSE = mean((test - ref)^2 / (ref^2 + 0.01)) at most 1.2x
+/// Mitsuba's own at the same size and spp: 0.001786, mean of seeds 0-7, from
+/// `python tools/mitsuba_refs.py relmse cornell-diffuse --res 64 --spp 64 --seeds 8`.
+/// Measured over seeds 0-2: means within 0.11%, relMSE 0.00060 (0.34x Mitsuba's).
 #[test]
-fn cornell_diffuse_mean_matches_mitsuba() {
-    let (w, h, reference) = read_exr(&repo().join("scenes/refs/images/cornell-diffuse.exr"));
-    assert_eq!((w, h), (256, 256));
-    let mut ref_mean = [0.0f64; 3];
-    for p in &reference {
-        for c in 0..3 {
-            ref_mean[c] += f64::from(p[c]) / reference.len() as f64;
-        }
-    }
-    let film = render(&scene("refs/cornell-diffuse.toml", 64, 32, 1));
-    let mean = film.mean();
+fn cornell_diffuse_matches_mitsuba() {
+    let reference = Film::read_exr(&repo().join("scenes/refs/images/cornell-diffuse.exr"))
+        .unwrap()
+        .downsample(4);
+    let film = render(&scene("refs/cornell-diffuse.toml", 64, 64, 0));
+    let (mean, ref_mean) = (film.mean(), reference.mean());
     for c in 0..3 {
         let ratio = mean[c] / ref_mean[c];
         assert!(
-            (ratio - 1.0).abs() < 0.025,
+            (ratio - 1.0).abs() <= 0.005,
             "channel {c}: pathlight {} vs Mitsuba {} (ratio {ratio})",
             mean[c],
             ref_mean[c]
         );
     }
+    let relmse = film.relmse(&reference);
+    assert!(relmse <= 1.2 * 0.001786, "relMSE {relmse}");
 }
 
 /// The running sum stays exact: 10^5 samples of a constant 0.1 (a camera seeing only the

@@ -1,0 +1,170 @@
+#!/usr/bin/env python3
+"""Mitsuba 3 references for pathlight's reference scenes, from pathlight's own scene files.
+
+Converts scenes/refs/NAME.toml (the subset with an exact Mitsuba equivalent: quads, spheres,
+OBJ meshes with scale + translate, emissive shapes as one-sided `area` emitters, two-sided
+diffuse, smooth or GGX-rough conductors and dielectrics with alpha = roughness^2, a
+constant environment) to a Mitsuba scene and either
+
+  render NAME [--res 512] [--spp 1024]   writes scenes/refs/images/NAME.exr and .png: the
+                                         2x2 box average of a res x res render (the
+                                         convention of the team's shared/refs images)
+  relmse NAME... [--res 128] [--spp 64] [--seeds 8]
+                                         prints Mitsuba's own relMSE against the stored
+                                         reference: mean over pixels and channels of
+                                         (test - ref)^2 / (ref^2 + 0.01), ref box-downsampled
+
+Needs: pip install mitsuba numpy; apt-get install libllvm19 (for llvm_ad_rgb, the default
+variant; DRJIT_LIBLLVM_PATH is set to Debian's libLLVM.so.19.1 when it exists).
+"""
+import argparse
+import json
+import math
+import os
+import time
+import tomllib
+
+import numpy as np
+
+LLVM19 = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1"
+if "DRJIT_LIBLLVM_PATH" not in os.environ and os.path.exists(LLVM19):
+    os.environ["DRJIT_LIBLLVM_PATH"] = LLVM19
+
+REFS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes", "refs")
+PRESETS = {"gold": ([0.143036, 0.375307, 1.44205], [3.983, 2.38556, 1.60336]),
+           "aluminium": ([1.6575, 0.880405, 0.521244], [9.22381, 6.2695, 4.837])}
+
+
+def rgb(v):
+    return {"type": "rgb", "value": [float(c) for c in v]}
+
+
+def bsdf(name, m):
+    if m.get("color_space_srgb"):
+        raise SystemExit(f"{name}: use color_space = \"linear\" for Mitsuba references")
+    alpha_s = m.get("specular_roughness", 0.0) ** 2
+    alpha_t = m.get("refract_roughness", 0.0) ** 2
+    if "emission" in m:
+        return {"type": "diffuse", "reflectance": rgb([0, 0, 0])}
+    if "conductor" in m or "eta" in m:
+        eta, k = PRESETS[m["conductor"]] if "conductor" in m else (m["eta"], m["k"])
+        out = {"type": "conductor", "eta": rgb(eta), "k": rgb(k)}
+        if alpha_s >= 1e-3:
+            out.update(type="roughconductor", distribution="ggx", alpha=alpha_s)
+        return out
+    if m.get("refract_rate", 0.0) == 1.0:
+        out = {"type": "dielectric", "int_ior": m.get("ior", 1.5), "ext_ior": 1.0}
+        if alpha_t >= 1e-3:
+            out.update(type="roughdielectric", distribution="ggx", alpha=alpha_t)
+        return out
+    if m.get("specular_rate", 0.0) == 0.0 and m.get("refract_rate", 0.0) == 0.0 and "texture" not in m:
+        return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": rgb(m.get("color", [0.8] * 3))}}
+    raise SystemExit(f"material {name} has no exact Mitsuba equivalent")
+
+
+def to_mitsuba(scene, res, spp):
+    import mitsuba as mi
+    T = mi.ScalarTransform4f
+    if scene.get("color_space") != "linear":
+        raise SystemExit("reference scenes must use color_space = \"linear\"")
+    cam = scene["camera"]
+    render = scene.get("render", {})
+    out = {
+        "type": "scene",
+        "integrator": {"type": "path", "max_depth": render.get("max_depth", 8),
+                       "rr_depth": render.get("rr_depth", 5), "hide_emitters": False},
+        "sensor": {
+            "type": "perspective", "fov": cam["fov_y"], "fov_axis": "y",
+            "to_world": T().look_at(origin=cam["position"], target=cam["look_at"], up=cam.get("up", [0, 1, 0])),
+            "film": {"type": "hdrfilm", "width": res, "height": res, "pixel_format": "rgb",
+                     "rfilter": {"type": "box"}},
+            "sampler": {"type": "independent", "sample_count": spp},
+        },
+    }
+    if "environment" in scene:
+        out["environment"] = {"type": "constant", "radiance": rgb(scene["environment"]["radiance"])}
+    materials = scene["materials"]
+
+    def attach(shape, mat_name):
+        m = materials[mat_name]
+        shape["bsdf"] = bsdf(mat_name, m)
+        if "emission" in m:
+            shape["emitter"] = {"type": "area", "radiance": rgb(m["emission"])}
+        return shape
+
+    for i, q in enumerate(scene.get("quad", [])):
+        u, v, o = (np.array(q[k], float) for k in ("edge_u", "edge_v", "origin"))
+        n = np.cross(u, v)
+        n /= np.linalg.norm(n)
+        m = np.eye(4)
+        m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = u / 2, v / 2, n, o + (u + v) / 2
+        out[f"quad{i}"] = attach({"type": "rectangle", "to_world": T(m)}, q["material"])
+    for i, s in enumerate(scene.get("sphere", [])):
+        if s.get("texture_rotation", 0):
+            raise SystemExit("texture rotation has no Mitsuba equivalent here")
+        out[f"sphere{i}"] = attach({"type": "sphere", "center": s["center"], "radius": s["radius"]}, s["material"])
+    for i, mesh in enumerate(scene.get("mesh", [])):
+        t = mesh.get("transform", {})
+        if any(t.get("rotate", [0, 0, 0])):
+            raise SystemExit("mesh rotation is not converted")
+        scale = t.get("scale", 1.0)
+        to_world = T().translate(t.get("translate", [0, 0, 0])) @ T().scale(scale if isinstance(scale, list) else [scale] * 3)
+        shape = {"type": "obj", "filename": os.path.join(REFS, mesh["file"]), "to_world": to_world,
+                 "face_normals": mesh.get("shading") == "flat"}
+        out[f"mesh{i}"] = attach(shape, mesh["material"])
+    for kind in ("cylinder", "revolve"):
+        if scene.get(kind):
+            raise SystemExit(f"{kind} shapes are not converted")
+    return out
+
+
+def load(name):
+    with open(os.path.join(REFS, name + ".toml"), "rb") as f:
+        return tomllib.load(f)
+
+
+def downsample(image, size):
+    factor = image.shape[0] // size
+    return image.reshape(size, factor, size, factor, 3).mean(axis=(1, 3))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("command", choices=["render", "relmse"])
+    ap.add_argument("names", nargs="+")
+    ap.add_argument("--res", type=int)
+    ap.add_argument("--spp", type=int)
+    ap.add_argument("--seeds", type=int, default=8)
+    ap.add_argument("--variant", default="llvm_ad_rgb")
+    a = ap.parse_args()
+    import mitsuba as mi
+    mi.set_variant(a.variant)
+    for name in a.names:
+        scene = load(name)
+        if a.command == "render":
+            res, spp, pass_spp = a.res or 512, a.spp or 1024, 64
+            mts = mi.load_dict(to_mitsuba(scene, res, pass_spp))
+            t0 = time.perf_counter()
+            acc = sum(np.asarray(mi.render(mts, spp=pass_spp, seed=i), np.float64) for i in range(spp // pass_spp))
+            img = downsample(acc / (spp // pass_spp), res // 2).astype(np.float32)
+            exr = os.path.join(REFS, "images", name + ".exr")
+            mi.Bitmap(img, mi.Bitmap.PixelFormat.RGB).write(exr)
+            mi.Bitmap(img, mi.Bitmap.PixelFormat.RGB).convert(
+                mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.UInt8, srgb_gamma=True).write(exr[:-4] + ".png")
+            print(json.dumps({"scene": name, "variant": a.variant, "res": res, "spp": spp,
+                              "seconds": round(time.perf_counter() - t0, 1), "exr": exr}), flush=True)
+        else:
+            res, spp = a.res or 128, a.spp or 64
+            ref = downsample(np.asarray(mi.Bitmap(os.path.join(REFS, "images", name + ".exr")), np.float64)[..., :3], res)
+            mts = mi.load_dict(to_mitsuba(scene, res, spp))
+            values = []
+            for seed in range(a.seeds):
+                img = np.asarray(mi.render(mts, spp=spp, seed=seed), np.float64)[..., :3]
+                values.append(float(np.mean((img - ref) ** 2 / (ref ** 2 + 0.01))))
+            print(json.dumps({"scene": name, "variant": a.variant, "res": res, "spp": spp,
+                              "relmse": [round(v, 6) for v in values],
+                              "mean_relmse": round(float(np.mean(values)), 6)}), flush=True)
+
+
+if __name__ == "__main__":
+    main()
