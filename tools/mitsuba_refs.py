@@ -57,8 +57,13 @@ def bsdf(name, m):
         if alpha_t >= 1e-3:
             out.update(type="roughdielectric", distribution="ggx", alpha=alpha_t)
         return out
-    if m.get("specular_rate", 0.0) == 0.0 and m.get("refract_rate", 0.0) == 0.0 and "texture" not in m:
-        return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": rgb(m.get("color", [0.8] * 3))}}
+    if m.get("specular_rate", 0.0) == 0.0 and m.get("refract_rate", 0.0) == 0.0:
+        if "texture" in m:
+            # 8-bit images are sRGB-decoded by Mitsuba, bilinear, as pathlight does.
+            reflectance = {"type": "bitmap", "filename": os.path.join(REFS, m["texture"]), "filter_type": "bilinear"}
+        else:
+            reflectance = rgb(m.get("color", [0.8] * 3))
+        return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": reflectance}}
     raise SystemExit(f"material {name} has no exact Mitsuba equivalent")
 
 
@@ -100,9 +105,18 @@ def to_mitsuba(scene, res, spp):
         m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = u / 2, v / 2, n, o + (u + v) / 2
         out[f"quad{i}"] = attach({"type": "rectangle", "to_world": T(m)}, q["material"])
     for i, s in enumerate(scene.get("sphere", [])):
-        if s.get("texture_rotation", 0):
-            raise SystemExit("texture rotation has no Mitsuba equivalent here")
-        out[f"sphere{i}"] = attach({"type": "sphere", "center": s["center"], "radius": s["radius"]}, s["material"])
+        # Mitsuba's sphere: u = atan2(y, x) / 2pi from local +x, v = angle from local +z / pi.
+        # pathlight's: v from +y, u = 0.5 + (atan2(x, z) + rotation) / 2pi. They agree when
+        # local x, y, z are world -z, -x, +y, turned about y by the texture rotation.
+        rot = math.radians(s.get("texture_rotation", 0.0))
+        c, sn = math.cos(rot), math.sin(rot)
+        r = s["radius"]
+        m = np.eye(4)
+        # Then Mitsuba's phi = atan2(n.ly, n.lx) = atan2(n.x, n.z) + rot + pi, as required.
+        lx = np.array([sn, 0.0, -c])
+        ly = np.array([-c, 0.0, -sn])
+        m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = lx * r, ly * r, np.array([0.0, r, 0.0]), s["center"]
+        out[f"sphere{i}"] = attach({"type": "sphere", "to_world": T(m)}, s["material"])
     for i, mesh in enumerate(scene.get("mesh", [])):
         t = mesh.get("transform", {})
         if any(t.get("rotate", [0, 0, 0])):

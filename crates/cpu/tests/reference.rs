@@ -14,10 +14,11 @@ use pathlight_cpu::CpuRenderer;
 
 /// Mitsuba 3.9.1's own relMSE at 128x128, 64 spp, llvm_ad_rgb, mean over seeds 0-7, from
 /// `python tools/mitsuba_refs.py relmse NAME --res 128 --spp 64 --seeds 8`.
-const MITSUBA_RELMSE_128: [(&str, f64); 5] = [
+const MITSUBA_RELMSE_128: [(&str, f64); 6] = [
     ("cornell-diffuse", 0.001777),
     ("cornell-spheres", 0.044131),
     ("cornell-materials", 0.019095),
+    ("textured-sphere", 0.004072),
     ("furnace-0.8", 0.000347),
     ("furnace-1.0", 0.000348),
 ];
@@ -82,6 +83,11 @@ fn cornell_spheres_matches_mitsuba() {
 #[test]
 fn cornell_materials_matches_mitsuba() {
     check_against_mitsuba("cornell-materials");
+}
+
+#[test]
+fn textured_sphere_matches_mitsuba() {
+    check_against_mitsuba("textured-sphere");
 }
 
 /// Furnaces: the sphere's pixels average to the albedo and the background reads 1, both
