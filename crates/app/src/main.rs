@@ -1,6 +1,8 @@
 //! `pathlight`: a progressive GPU path tracer. See `pathlight --help`.
 
 mod cli;
+#[macro_use]
+mod note;
 mod output;
 mod progress;
 mod render_cmd;
@@ -21,7 +23,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            eprintln!("error: {err:#}");
+            note!("error: {err:#}");
             ExitCode::FAILURE
         }
     }

@@ -57,7 +57,7 @@ impl Progress {
             None => {
                 if self.last_line.elapsed() >= LINE_INTERVAL || spp_done == self.total_spp {
                     self.last_line = Instant::now();
-                    eprintln!(
+                    note!(
                         "rendered {spp_done}/{} spp ({:.0}%), {rate}",
                         self.total_spp,
                         100.0 * f64::from(spp_done) / f64::from(self.total_spp)

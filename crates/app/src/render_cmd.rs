@@ -98,11 +98,11 @@ fn render_to_file(scene: &Scene, args: &RenderArgs) -> anyhow::Result<()> {
     };
     let mut renderer = match &ctx {
         Some(ctx) => {
-            eprintln!("adapter: {}", describe(&ctx.adapter_info));
+            note!("adapter: {}", describe(&ctx.adapter_info));
             Renderer::Gpu(ProgressiveRenderer::new(ctx, scene, &gpu_scene)?)
         }
         None => {
-            eprintln!("backend: cpu, {} threads", rayon::current_num_threads());
+            note!("backend: cpu, {} threads", rayon::current_num_threads());
             Renderer::Cpu(CpuRenderer::new(scene, gpu_scene))
         }
     };
@@ -128,9 +128,9 @@ fn render_to_file(scene: &Scene, args: &RenderArgs) -> anyhow::Result<()> {
     }
     output::write(&film, &args.output)?;
     if film.spp < total {
-        eprintln!("interrupted: kept {} of {total} spp", film.spp);
+        note!("interrupted: kept {} of {total} spp", film.spp);
     }
-    eprintln!(
+    note!(
         "wrote {}: {width}x{height}, {} spp, render {:.2} s ({:.2} M samples/s), total {:.2} s",
         args.output.display(),
         film.spp,

@@ -180,6 +180,36 @@ fn adapter_choice_errors_are_clear() {
     );
 }
 
+/// A stderr that cannot be written (a closed pipe, `2>&1 | head -1`) neither panics nor
+/// loses the image.
+#[test]
+fn unwritable_stderr_still_writes_the_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("quiet.png");
+    // A pipe whose reading end is closed at once: every write to it fails with EPIPE.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pathlight"))
+        .args([
+            "render",
+            "--backend",
+            "cpu",
+            "--spp",
+            "1",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "-o",
+        ])
+        .arg(&out)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stderr.take());
+    let status = child.wait().unwrap();
+    assert!(status.success(), "{status}");
+    assert!(std::fs::metadata(&out).unwrap().len() > 0);
+}
+
 #[test]
 fn list_adapters_names_one() {
     let output = pathlight(&["render", "--list-adapters"]);
