@@ -210,6 +210,41 @@ fn unwritable_stderr_still_writes_the_image() {
     assert!(std::fs::metadata(&out).unwrap().len() > 0);
 }
 
+/// Ctrl-C (SIGINT) stops the render between batches and writes what was rendered.
+#[test]
+fn interrupt_keeps_the_rendered_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("interrupted.png");
+    let child = Command::new(env!("CARGO_BIN_EXE_pathlight"))
+        .args([
+            "render",
+            "--backend",
+            "cpu",
+            "--spp",
+            "1000000",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "-o",
+        ])
+        .arg(&out)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let output = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{}: {err}", output.status);
+    assert!(err.contains("interrupted: kept"), "{err}");
+    assert!(std::fs::metadata(&out).unwrap().len() > 0);
+}
+
 #[test]
 fn list_adapters_names_one() {
     let output = pathlight(&["render", "--list-adapters"]);
