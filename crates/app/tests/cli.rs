@@ -35,25 +35,25 @@ fn fails_with(args: &[&str], needles: &[&str]) -> String {
     err
 }
 
-fn read_exr(path: &Path) -> (usize, Vec<[f32; 3]>) {
-    use exr::prelude::*;
-    let image = read_first_rgba_layer_from_file(
-        path,
-        |resolution, _| {
-            (
-                resolution.width(),
-                vec![[0.0f32; 3]; resolution.width() * resolution.height()],
-            )
-        },
-        |(width, pixels), position, (r, g, b, _a): (f32, f32, f32, f32)| {
-            pixels[position.y() * *width + position.x()] = [r, g, b];
-        },
-    )
-    .unwrap();
-    (
-        image.layer_data.size.width(),
-        image.layer_data.channel_data.pixels.1,
-    )
+/// Starts a 16x16 CPU render of the default scene at `spp` into `out`, stderr piped.
+fn spawn_cpu_render(spp: &str, out: &Path) -> std::process::Child {
+    Command::new(env!("CARGO_BIN_EXE_pathlight"))
+        .args([
+            "render",
+            "--backend",
+            "cpu",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--spp",
+            spp,
+            "-o",
+        ])
+        .arg(out)
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap()
 }
 
 /// The acceptance command: centre pixels 0.8 +- 0.01, background 1.0 +- 0.005.
@@ -76,7 +76,8 @@ fn furnace_exr_reads_albedo_and_background() {
     let err = stderr(&output);
     assert!(output.status.success(), "{err}");
     assert!(err.contains("adapter: "), "the adapter is printed:\n{err}");
-    let (width, pixels) = read_exr(&out);
+    let film = pathlight_core::Film::read_exr(&out).unwrap();
+    let (width, pixels) = (film.width as usize, film.pixels);
     assert_eq!((width, pixels.len()), (64, 64 * 64));
     for y in 28..36 {
         for x in 28..36 {
@@ -187,23 +188,7 @@ fn unwritable_stderr_still_writes_the_image() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("quiet.png");
     // A pipe whose reading end is closed at once: every write to it fails with EPIPE.
-    let mut child = Command::new(env!("CARGO_BIN_EXE_pathlight"))
-        .args([
-            "render",
-            "--backend",
-            "cpu",
-            "--spp",
-            "1",
-            "--width",
-            "16",
-            "--height",
-            "16",
-            "-o",
-        ])
-        .arg(&out)
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = spawn_cpu_render("1", &out);
     drop(child.stderr.take());
     let status = child.wait().unwrap();
     assert!(status.success(), "{status}");
@@ -215,23 +200,7 @@ fn unwritable_stderr_still_writes_the_image() {
 fn interrupt_keeps_the_rendered_samples() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("interrupted.png");
-    let child = Command::new(env!("CARGO_BIN_EXE_pathlight"))
-        .args([
-            "render",
-            "--backend",
-            "cpu",
-            "--spp",
-            "1000000",
-            "--width",
-            "16",
-            "--height",
-            "16",
-            "-o",
-        ])
-        .arg(&out)
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
+    let child = spawn_cpu_render("1000000", &out);
     std::thread::sleep(std::time::Duration::from_millis(1500));
     let killed = Command::new("kill")
         .args(["-INT", &child.id().to_string()])

@@ -137,15 +137,15 @@ fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
         base_color: m.base_color.to_array(),
         texture: m.texture.map_or(-1, |t| t as i32),
         emission: m.emission.to_array(),
-        specular_rate: m.specular_rate,
+        specular_rate: m.lobes.specular_rate,
         eta: conductor.eta.to_array(),
-        specular_tint: m.specular_tint,
+        specular_tint: m.lobes.specular_tint,
         k: conductor.k.to_array(),
-        specular_roughness: m.specular_roughness,
-        refract_rate: m.refract_rate,
-        refract_tint: m.refract_tint,
-        ior: m.ior,
-        refract_roughness: m.refract_roughness,
+        specular_roughness: m.lobes.specular_roughness,
+        refract_rate: m.lobes.refract_rate,
+        refract_tint: m.lobes.refract_tint,
+        ior: m.lobes.ior,
+        refract_roughness: m.lobes.refract_roughness,
         conductor: u32::from(m.conductor.is_some()),
         pad: [0; 3],
     }
@@ -269,8 +269,9 @@ impl GpuScene {
         out
     }
 
-    /// Surface area of light-table entry `(object, primitive)`.
-    fn emitter_area(&self, object: &GpuObject, primitive: u32) -> f32 {
+    /// Surface area of light-table entry `(object, primitive)`: the whole shape, or
+    /// triangle `primitive` of a mesh. Twin of WGSL `emitter_area`.
+    pub fn emitter_area(&self, object: &GpuObject, primitive: u32) -> f32 {
         let [a, b, c] = [object.a, object.b, object.c].map(|v| Vec3::from_slice(&v));
         match object.kind {
             KIND_QUAD => b.cross(c).length(),
@@ -298,10 +299,7 @@ impl GpuScene {
         let mut powers = Vec::new();
         for i in 0..self.object_count as usize {
             let object = self.objects[i];
-            let e = self
-                .materials
-                .get(object.material as usize)
-                .map_or(Vec3::ZERO, |m| Vec3::from(m.emission));
+            let e = Vec3::from(self.materials[object.material as usize].emission);
             let luminance = e
                 .dot(Vec3::new(0.2126, 0.7152, 0.0722))
                 .max(e.max_element() * 1e-3);

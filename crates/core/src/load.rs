@@ -279,11 +279,7 @@ impl Builder<'_, '_> {
             Some(path) => Some(self.texture(span.clone(), &key("texture"), path)?),
             None => None,
         };
-        Ok(Material {
-            name: name.to_owned(),
-            base_color,
-            texture,
-            emission,
+        let lobes = Lobes {
             specular_rate,
             specular_tint: self.unit(
                 span.clone(),
@@ -307,6 +303,13 @@ impl Builder<'_, '_> {
                 &key("refract_roughness"),
                 m.refract_roughness.unwrap_or(base.refract_roughness),
             )?,
+        };
+        Ok(Material {
+            name: name.to_owned(),
+            base_color,
+            texture,
+            emission,
+            lobes,
             conductor,
         })
     }

@@ -177,20 +177,8 @@ pub struct Material {
     pub texture: Option<u32>,
     /// Emitted radiance on the front side.
     pub emission: Vec3,
-    /// Weight of the specular reflection lobe.
-    pub specular_rate: f32,
-    /// Specular colour between white and the base colour.
-    pub specular_tint: f32,
-    /// Roughness of the specular lobe.
-    pub specular_roughness: f32,
-    /// Weight of the transmission lobe.
-    pub refract_rate: f32,
-    /// Transmitted colour between white and the base colour.
-    pub refract_tint: f32,
-    /// Index of refraction of the inside.
-    pub ior: f32,
-    /// Roughness of transmission.
-    pub refract_roughness: f32,
+    /// Lobe weights and parameters.
+    pub lobes: Lobes,
     /// Complex-IOR Fresnel for the specular lobe, else Schlick from the specular colour.
     pub conductor: Option<Conductor>,
 }

@@ -3,7 +3,7 @@
 
 use glam::{Vec2, Vec3};
 use pathlight_core::gpu::{GpuBvhNode, KIND_MESH};
-use pathlight_core::scene::{Camera, RenderSettings, TriangleMesh};
+use pathlight_core::scene::{Camera, Lobes, Material, RenderSettings, TriangleMesh};
 use pathlight_core::trace::{Hit, Ray, intersect_triangle, safe_inverse};
 use pathlight_core::{GpuScene, Object, Scene, Shape};
 use rand::rngs::StdRng;
@@ -27,7 +27,14 @@ fn scene_of(objects: Vec<Object>) -> Scene {
             sampler: 0,
         },
         environment: Vec3::ZERO,
-        materials: Vec::new(),
+        materials: vec![Material {
+            name: "grey".into(),
+            base_color: Vec3::splat(0.5),
+            texture: None,
+            emission: Vec3::ZERO,
+            lobes: Lobes::DIFFUSE,
+            conductor: None,
+        }],
         textures: Vec::new(),
         objects,
     }

@@ -189,10 +189,13 @@ fn seed_presets_give_defaults_that_keys_override() {
             .unwrap()
             .clone()
     };
-    assert_eq!((m("a").specular_rate, m("a").specular_tint), (1.0, 1.0));
-    assert_eq!((m("b").refract_rate, m("b").ior), (1.0, 1.33));
-    assert_eq!(m("c").specular_rate, 0.5);
-    assert!(m("c").specular_roughness > 0.0);
+    assert_eq!(
+        (m("a").lobes.specular_rate, m("a").lobes.specular_tint),
+        (1.0, 1.0)
+    );
+    assert_eq!((m("b").lobes.refract_rate, m("b").lobes.ior), (1.0, 1.33));
+    assert_eq!(m("c").lobes.specular_rate, 0.5);
+    assert!(m("c").lobes.specular_roughness > 0.0);
     let message = error("[materials.m]\npreset = \"marble\"\n");
     assert!(
         message.starts_with("test.toml:6:") && message.contains("ceramic"),

@@ -49,18 +49,6 @@ pub fn env_pdf(params: &GpuFrameParams, n: Vec3, wi: Vec3) -> f32 {
     params.env_pmf * n.dot(wi).max(0.0) / PI
 }
 
-/// Area of a cylinder (side and caps). Twin of WGSL `cylinder_area`.
-fn cylinder_area(o: &GpuObject) -> f32 {
-    let r = o.a[3];
-    let h = (Vec3::from_slice(&o.b) - Vec3::from_slice(&o.a)).length();
-    let caps = if o.flags & FLAG_CAPS != 0 {
-        2.0 * PI * r * r
-    } else {
-        0.0
-    };
-    TAU * r * h + caps
-}
-
 /// `1 - cos` of the half-angle of the cone a sphere subtends from `p`, or a negative value
 /// when `p` is inside it. Twin of WGSL `sphere_cone`.
 fn sphere_cone(center: Vec3, radius: f32, p: Vec3) -> f32 {
@@ -96,22 +84,13 @@ pub fn light_pdf(
     let to_light = p_light - p;
     let d2 = to_light.length_squared();
     let cos_l = n_light.dot(-to_light).abs() / d2.sqrt();
-    let [a, b, c] = [o.a, o.b, o.c].map(|v| Vec3::from_slice(&v));
-    let area = match o.kind {
-        KIND_QUAD => b.cross(c).length(),
-        KIND_SPHERE => {
-            let one_minus_cos = sphere_cone(a, o.a[3], p);
-            if one_minus_cos > 0.0 {
-                return pmf / (TAU * one_minus_cos);
-            }
-            4.0 * PI * o.a[3] * o.a[3]
+    if o.kind == KIND_SPHERE {
+        let one_minus_cos = sphere_cone(Vec3::from_slice(&o.a), o.a[3], p);
+        if one_minus_cos > 0.0 {
+            return pmf / (TAU * one_minus_cos);
         }
-        KIND_CYLINDER => cylinder_area(o),
-        _ => {
-            let [v0, v1, v2] = scene.triangle(primitive);
-            0.5 * (v1 - v0).cross(v2 - v0).length()
-        }
-    };
+    }
+    let area = scene.emitter_area(o, primitive);
     if cos_l <= 0.0 || area <= 0.0 {
         return 0.0;
     }
@@ -165,7 +144,7 @@ fn sample_shape(
             let height = axis_full.length();
             let axis = axis_full / height;
             let frame = Frame::around(axis);
-            let area = cylinder_area(o);
+            let area = scene.emitter_area(o, primitive);
             let side = TAU * radius * height;
             if u_part * area < side || o.flags & FLAG_CAPS == 0 {
                 let phi = TAU * u.x;

@@ -58,6 +58,14 @@ fn cases() -> Vec<(&'static str, GpuMaterial)> {
     ]
 }
 
+/// Mean of `values` and its standard error.
+fn mean_and_error(values: &[f64]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n;
+    (mean, (var / n).sqrt())
+}
+
 fn surface() -> Surface {
     Surface {
         position: Vec3::ZERO,
@@ -125,15 +133,14 @@ fn densities_integrate_to_the_non_delta_probability() {
                         * f64::from(PI)
                 })
                 .collect();
-            let mean = integrals.iter().sum::<f64>() / N as f64;
-            let var = integrals.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / N as f64;
+            let (mean, error) = mean_and_error(&integrals);
             // Probability that sampling gives a valid non-delta direction.
             let hits = (0..N).filter(|_| {
                 let bs = sample(&mut rng, &m, wo);
                 bs.valid && !bs.delta
             });
             let p = hits.count() as f64 / N as f64;
-            let sigma = (var / N as f64).sqrt() + (p * (1.0 - p) / N as f64).sqrt();
+            let sigma = error + (p * (1.0 - p) / N as f64).sqrt();
             assert!(
                 (mean - p).abs() <= 5.0 * sigma + 2e-3,
                 "{name}, wo {wo}: integral {mean} vs probability {p}"
@@ -157,8 +164,7 @@ fn no_material_creates_energy() {
                     }
                 })
                 .collect();
-            let mean = weights.iter().sum::<f64>() / N as f64;
-            let var = weights.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / N as f64;
+            let (mean, error) = mean_and_error(&weights);
             // Refraction scales radiance by 1/eta^2 going in and eta^2 coming out.
             let bound = if wo.z < 0.0 && m.refract_rate > 0.0 {
                 2.25
@@ -166,7 +172,7 @@ fn no_material_creates_energy() {
                 1.0
             };
             assert!(
-                mean <= bound + 5.0 * (var / N as f64).sqrt() + 1e-4,
+                mean <= bound + 5.0 * error + 1e-4,
                 "{name}, wo {wo}: albedo {mean}"
             );
             if name == "lambert" && wo.z > 0.0 {
@@ -214,10 +220,9 @@ fn fresnel_and_ggx_closed_forms() {
                 }
             })
             .collect();
-        let mean = values.iter().sum::<f64>() / N as f64;
-        let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / N as f64;
+        let (mean, error) = mean_and_error(&values);
         assert!(
-            (mean - 1.0).abs() < 5.0 * (var / N as f64).sqrt() + 1e-3,
+            (mean - 1.0).abs() < 5.0 * error + 1e-3,
             "alpha {alpha}: {mean}"
         );
     }

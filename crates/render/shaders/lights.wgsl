@@ -25,11 +25,27 @@ fn env_pdf(n: vec3f, wi: vec3f) -> f32 {
     return params.env_pmf * max(0.0, dot(n, wi)) / PI;
 }
 
-fn cylinder_area(o: Object) -> f32 {
-    let r = o.a.w;
-    let h = length(o.b.xyz - o.a.xyz);
-    let caps = select(0.0, 2.0 * PI * r * r, (o.flags & FLAG_CAPS) != 0u);
-    return TAU * r * h + caps;
+// Surface area of light-table entry (o, primitive): the whole shape, or one triangle of a
+// mesh. Host twin: `GpuScene::emitter_area` (which also weighs the table by it).
+fn emitter_area(o: Object, primitive: u32) -> f32 {
+    switch o.kind {
+        case KIND_QUAD: {
+            return length(cross(o.b.xyz, o.c.xyz));
+        }
+        case KIND_SPHERE: {
+            return 4.0 * PI * o.a.w * o.a.w;
+        }
+        case KIND_CYLINDER: {
+            let r = o.a.w;
+            let caps = select(0.0, 2.0 * PI * r * r, (o.flags & FLAG_CAPS) != 0u);
+            return TAU * r * length(o.b.xyz - o.a.xyz) + caps;
+        }
+        default: {
+            let i = 3u * primitive;
+            let v0 = vertices[i].position;
+            return 0.5 * length(cross(vertices[i + 1u].position - v0, vertices[i + 2u].position - v0));
+        }
+    }
 }
 
 // 1 - cos of the half-angle of the cone a sphere subtends from p; negative inside it.
@@ -55,27 +71,13 @@ fn light_pdf(object: u32, primitive: u32, p: vec3f, p_light: vec3f, n_light: vec
     let to_light = p_light - p;
     let d2 = dot(to_light, to_light);
     let cos_l = abs(dot(n_light, -to_light)) / sqrt(d2);
-    var area: f32;
-    switch o.kind {
-        case KIND_QUAD: {
-            area = length(cross(o.b.xyz, o.c.xyz));
-        }
-        case KIND_SPHERE: {
-            let one_minus_cos = sphere_cone(o.a.xyz, o.a.w, p);
-            if one_minus_cos > 0.0 {
-                return pmf / (TAU * one_minus_cos);
-            }
-            area = 4.0 * PI * o.a.w * o.a.w;
-        }
-        case KIND_CYLINDER: {
-            area = cylinder_area(o);
-        }
-        default: {
-            let i = 3u * primitive;
-            let v0 = vertices[i].position;
-            area = 0.5 * length(cross(vertices[i + 1u].position - v0, vertices[i + 2u].position - v0));
+    if o.kind == KIND_SPHERE {
+        let one_minus_cos = sphere_cone(o.a.xyz, o.a.w, p);
+        if one_minus_cos > 0.0 {
+            return pmf / (TAU * one_minus_cos);
         }
     }
+    let area = emitter_area(o, primitive);
     if cos_l <= 0.0 || area <= 0.0 {
         return 0.0;
     }
@@ -123,7 +125,7 @@ fn sample_shape(o: Object, primitive: u32, p: vec3f, u: vec2f, u_part: f32) -> S
             let height = length(axis_full);
             let axis = axis_full / height;
             let frame = frame_around(axis);
-            let area = cylinder_area(o);
+            let area = emitter_area(o, primitive);
             let side = TAU * radius * height;
             if u_part * area < side || (o.flags & FLAG_CAPS) == 0u {
                 let phi = TAU * u.x;

@@ -132,35 +132,37 @@ fn cornell_diffuse_matches_mitsuba() {
     assert!(relmse <= 1.2 * 0.001786, "relMSE {relmse}");
 }
 
-/// The running sum stays exact: 10^5 samples of a constant 0.1 (a camera seeing only the
-/// environment) average to the f32 value of 0.1 within 1e-7 relative (fixed-point sums lose
-/// under 2^-32 per sample).
-#[test]
-fn accumulation_stays_exact_after_1e5_samples() {
-    let mut s = scene("refs/furnace-1.0.toml", 8, 100_000, 0);
+/// An 8x8 camera seeing only a constant environment of 0.1, at `spp`.
+fn constant_environment(spp: u32) -> pathlight_core::Scene {
+    let mut s = scene("refs/furnace-1.0.toml", 8, spp, 0);
     s.objects.clear();
     s.environment = Vec3::splat(0.1);
-    let film = render(&s);
-    assert_eq!(film.spp, 100_000);
-    for p in &film.pixels {
-        for c in p {
-            assert!(
-                ((c - 0.1) / 0.1).abs() < 1e-7,
-                "pixel {c} after 1e5 samples of 0.1"
-            );
-        }
+    s
+}
+
+/// Every pixel of `film` equals 0.1 within 1e-7 relative (fixed-point sums lose under
+/// 2^-32 per sample; a float running sum drifts far more).
+fn assert_exactly_one_tenth(film: &pathlight_core::Film, what: &str) {
+    for c in film.pixels.iter().flatten() {
+        assert!(((c - 0.1) / 0.1).abs() < 1e-7, "pixel {c} after {what}");
     }
 }
 
+/// The running sum stays exact: 10^5 samples of a constant 0.1 average to it.
+#[test]
+fn accumulation_stays_exact_after_1e5_samples() {
+    let film = render(&constant_environment(100_000));
+    assert_eq!(film.spp, 100_000);
+    assert_exactly_one_tenth(&film, "1e5 samples of 0.1");
+}
+
 /// One sample per dispatch (the viewer's case) is where a float running sum drifts: 1000
-/// dispatches of a constant 0.1 must average to it within 1e-7 relative. A plain f32 sum
-/// was measured 3e-5 off after 3000 such dispatches on lavapipe, and so was a Kahan sum,
-/// whose compensation Mesa's compiler folds away; the fixed-point sum is exact.
+/// dispatches of a constant 0.1 must average to it exactly. A plain f32 sum was measured
+/// 3e-5 off after 3000 such dispatches on lavapipe, and so was a Kahan sum, whose
+/// compensation Mesa's compiler folds away.
 #[test]
 fn single_sample_batches_accumulate_exactly() {
-    let mut s = scene("refs/furnace-1.0.toml", 8, 1000, 0);
-    s.objects.clear();
-    s.environment = Vec3::splat(0.1);
+    let s = constant_environment(1000);
     let gpu_scene = pathlight_core::GpuScene::build(&s);
     let mut renderer =
         pathlight_render::ProgressiveRenderer::new(context(), &s, &gpu_scene).unwrap();
@@ -169,14 +171,7 @@ fn single_sample_batches_accumulate_exactly() {
     }
     let film = renderer.read_film().unwrap();
     assert_eq!(film.spp, 1000);
-    for p in &film.pixels {
-        for c in p {
-            assert!(
-                ((c - 0.1) / 0.1).abs() < 1e-7,
-                "pixel {c} after 1000 one-sample batches of 0.1"
-            );
-        }
-    }
+    assert_exactly_one_tenth(&film, "1000 one-sample batches of 0.1");
 }
 
 /// The image does not depend on how the work is cut: bands of 5 rows and 1 sample per
