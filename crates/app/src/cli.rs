@@ -19,6 +19,8 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene headless to a PNG or EXR file.
     Render(RenderArgs),
+    /// Measure frames per second, samples/s and rays/s (one sample per pixel per frame).
+    Bench(BenchArgs),
 }
 
 /// Where the light transport runs.
@@ -30,17 +32,11 @@ pub enum Backend {
     Cpu,
 }
 
-/// Options of `pathlight render`.
+/// The scene and the settings every command may override.
 #[derive(Debug, clap::Args)]
-pub struct RenderArgs {
+pub struct SceneArgs {
     /// Scene file (TOML, see docs/scene-format.md); the built-in default scene when absent.
     pub scene: Option<PathBuf>,
-    /// Output image: `.png` (sRGB, clamped, 8-bit) or `.exr` (linear float RGB).
-    #[arg(short, long, default_value = "pathlight.png")]
-    pub output: PathBuf,
-    /// Samples per pixel (overrides the scene's `render.spp`).
-    #[arg(long)]
-    pub spp: Option<u32>,
     /// Image width in pixels (overrides the scene's camera resolution).
     #[arg(long)]
     pub width: Option<u32>,
@@ -54,6 +50,11 @@ pub struct RenderArgs {
     /// 2 = direct light only (overrides the scene's `render.max_depth`).
     #[arg(long)]
     pub max_depth: Option<u32>,
+}
+
+/// Which device renders.
+#[derive(Debug, clap::Args)]
+pub struct DeviceArgs {
     /// Where the light transport runs.
     #[arg(long, value_enum, default_value_t = Backend::Gpu)]
     pub backend: Backend,
@@ -61,7 +62,70 @@ pub struct RenderArgs {
     /// (`vulkan`, `gl`, ...). `WGPU_BACKEND=vulkan,gl` restricts the backends searched.
     #[arg(long, value_name = "NAME")]
     pub adapter: Option<String>,
+}
+
+/// Options of `pathlight render`.
+#[derive(Debug, clap::Args)]
+pub struct RenderArgs {
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub scene: SceneArgs,
+    /// Output image: `.png` (sRGB, clamped, 8-bit) or `.exr` (linear float RGB).
+    #[arg(short, long, default_value = "pathlight.png")]
+    pub output: PathBuf,
+    /// Samples per pixel (overrides the scene's `render.spp`).
+    #[arg(long)]
+    pub spp: Option<u32>,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub device: DeviceArgs,
     /// List the adapters found and exit.
     #[arg(long)]
     pub list_adapters: bool,
+}
+
+/// How the nearest hit is found (`pathlight bench --accel`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum AccelArg {
+    /// The two-level BVH (what `render` uses).
+    Bvh,
+    /// Every object in turn; a mesh's triangles only inside its bounding box (the seed's
+    /// bounding cylinder).
+    BoundingVolume,
+    /// Every object and every triangle in turn.
+    BruteForce,
+}
+
+/// Options of `pathlight bench`.
+#[derive(Debug, clap::Args)]
+pub struct BenchArgs {
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub device: DeviceArgs,
+    /// Frames to time (one sample per pixel each), after the warm-up.
+    #[arg(long, default_value_t = 1000)]
+    pub frames: u32,
+    /// Untimed frames first (shader compilation, caches, clocks).
+    #[arg(long, default_value_t = 16)]
+    pub warmup: u32,
+    /// Stop the warm-up, and the timed frames, after this many seconds each (at least one
+    /// frame is always timed), so slow adapters finish.
+    #[arg(long, default_value_t = 20.0, value_name = "SECONDS")]
+    pub time_limit: f64,
+    /// How the nearest hit is found (GPU backend).
+    #[arg(long, value_enum, default_value_t = AccelArg::Bvh)]
+    pub accel: AccelArg,
+    /// Leave out the object of this name (repeatable), e.g. `--without vase`.
+    #[arg(long, value_name = "NAME")]
+    pub without: Vec<String>,
+    /// Reproduce the seed's frame-rate table: brute force, bounding volume, BVH, and BVH
+    /// without the vase, next to the seed's figures.
+    #[arg(long, conflicts_with_all = ["accel", "without"])]
+    pub seed_table: bool,
+    /// Print the results as JSON on standard output instead of a table.
+    #[arg(long)]
+    pub json: bool,
 }

@@ -1,11 +1,13 @@
 //! `pathlight`: a progressive GPU path tracer. See `pathlight --help`.
 
-mod cli;
 #[macro_use]
 mod note;
+mod bench_cmd;
+mod cli;
 mod output;
 mod progress;
 mod render_cmd;
+mod setup;
 
 use std::process::ExitCode;
 
@@ -19,6 +21,7 @@ fn main() -> ExitCode {
     let cli = cli::Cli::parse();
     let result = match cli.command {
         cli::Command::Render(args) => render_cmd::run(&args),
+        cli::Command::Bench(args) => bench_cmd::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

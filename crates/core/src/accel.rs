@@ -164,7 +164,7 @@ fn gpu_object(object: &Object, id: u32) -> GpuObject {
         flags: 0,
         light: NO_LIGHT,
         first_triangle: 0,
-        pad: 0,
+        triangle_count: 0,
     };
     match object.shape {
         Shape::Quad {
@@ -243,6 +243,7 @@ impl GpuScene {
                 if let Shape::Mesh(mesh) = &object.shape {
                     gpu.first_triangle = (out.vertices.len() / 3) as u32;
                     gpu.blas_root = out.append_mesh(mesh);
+                    gpu.triangle_count = (out.vertices.len() / 3) as u32 - gpu.first_triangle;
                 }
                 out.objects.push(gpu);
             }
@@ -308,8 +309,7 @@ impl GpuScene {
                 continue;
             }
             let primitives = if object.kind == KIND_MESH {
-                let count = self.mesh_triangle_count(object.blas_root);
-                object.first_triangle..object.first_triangle + count
+                object.first_triangle..object.first_triangle + object.triangle_count
             } else {
                 0..1
             };
@@ -344,21 +344,6 @@ impl GpuScene {
         if self.lights.is_empty() {
             self.lights.push(GpuLight::zeroed());
         }
-    }
-
-    /// Number of triangles under the BLAS rooted at `root`.
-    fn mesh_triangle_count(&self, root: u32) -> u32 {
-        let mut stack = vec![root];
-        let mut count = 0;
-        while let Some(i) = stack.pop() {
-            let node = &self.nodes[i as usize];
-            if node.prim_count == 0 {
-                stack.extend([node.first_index, node.first_index + 1]);
-            } else {
-                count += node.prim_count;
-            }
-        }
-        count
     }
 
     /// Appends a mesh's BLAS and triangles; returns the BLAS root's node index.

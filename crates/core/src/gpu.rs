@@ -57,8 +57,8 @@ pub struct GpuObject {
     pub light: u32,
     /// Mesh only: index of its first triangle in the vertex buffer (in triangles).
     pub first_triangle: u32,
-    /// Padding to 16 bytes.
-    pub pad: u32,
+    /// Mesh only: number of its triangles (`first_triangle ..` in the vertex buffer).
+    pub triangle_count: u32,
 }
 const _: () = assert!(size_of::<GpuObject>() == 80);
 

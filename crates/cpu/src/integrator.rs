@@ -56,13 +56,23 @@ fn occluded(scene: &GpuScene, p: Vec3, ng: Vec3, ls: &LightSample) -> bool {
     scene.intersect(&ray, distance * (1.0 - 1e-4)).is_some()
 }
 
+/// What one camera path brought back.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathSample {
+    /// Radiance along the path.
+    pub radiance: Vec3,
+    /// Rays traced for it (camera, extension and shadow rays).
+    pub rays: u32,
+}
+
 /// Radiance along one camera path. Twin of WGSL `trace_path`.
 pub fn trace_path(
     scene: &GpuScene,
     params: &GpuFrameParams,
     first: Ray,
     sampler: &mut Sampler,
-) -> Vec3 {
+) -> PathSample {
+    let mut rays = 0;
     let mut ray = first;
     let mut radiance = Vec3::ZERO;
     let mut throughput = Vec3::ONE;
@@ -79,6 +89,7 @@ pub fn trace_path(
     let mut eta_scale = 1.0f32;
     let environment = Vec3::from(params.environment);
     for depth in 1..=params.max_depth {
+        rays += 1;
         let Some(hit) = scene.intersect(&ray, T_MAX) else {
             let w = if prev_delta {
                 1.0
@@ -126,9 +137,12 @@ pub fn trace_path(
             let ls = sample_light(scene, params, s.position, n, u_light_select, u_light);
             if ls.valid {
                 let e = eval_bsdf(material, color, &s, wo, ls.wi);
-                if e.f.max_element() > 0.0 && !occluded(scene, s.position, s.ng, &ls) {
-                    radiance +=
-                        throughput * e.f * ls.radiance * power_heuristic(ls.pdf, e.pdf) / ls.pdf;
+                if e.f.max_element() > 0.0 {
+                    rays += 1;
+                    if !occluded(scene, s.position, s.ng, &ls) {
+                        radiance += throughput * e.f * ls.radiance * power_heuristic(ls.pdf, e.pdf)
+                            / ls.pdf;
+                    }
                 }
             }
         }
@@ -154,7 +168,7 @@ pub fn trace_path(
             dir: bs.wi,
         };
     }
-    radiance
+    PathSample { radiance, rays }
 }
 
 /// A sample as it is accumulated: non-finite samples count as zero, channels are clamped to

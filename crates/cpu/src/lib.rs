@@ -31,6 +31,8 @@ pub struct CpuRenderer {
     sums: Vec<[f64; 3]>,
     samples_done: u32,
     batch_samples: u32,
+    /// Rays traced so far.
+    rays_traced: u64,
 }
 
 impl CpuRenderer {
@@ -44,12 +46,18 @@ impl CpuRenderer {
             sums: vec![[0.0; 3]; pixels],
             samples_done: 0,
             batch_samples: 1,
+            rays_traced: 0,
         }
     }
 
     /// Samples per pixel accumulated so far.
     pub fn samples_done(&self) -> u32 {
         self.samples_done
+    }
+
+    /// Rays traced so far (camera, extension and shadow rays).
+    pub fn rays_traced(&self) -> u64 {
+        self.rays_traced
     }
 
     /// Adds up to `max_samples` samples per pixel (at least one when `max_samples` > 0) in
@@ -63,23 +71,30 @@ impl CpuRenderer {
         let started = Instant::now();
         let (scene, params, offset) = (&self.scene, &self.params, self.samples_done);
         let width = params.width as usize;
-        self.sums
+        let rays: u64 = self
+            .sums
             .par_chunks_mut(width)
             .enumerate()
-            .for_each(|(y, row)| {
+            .map(|(y, row)| {
+                let mut rays = 0;
                 for (x, sum) in row.iter_mut().enumerate() {
                     let pixel = (y * width + x) as u32;
                     for i in 0..samples {
                         let mut sampler =
                             Sampler::new(params.sampler, pixel, offset + i, params.seed);
                         let ray = camera_ray(params, x as u32, y as u32, &mut sampler);
-                        let value = accumulated_value(trace_path(scene, params, ray, &mut sampler));
+                        let path = trace_path(scene, params, ray, &mut sampler);
+                        rays += u64::from(path.rays);
+                        let value = accumulated_value(path.radiance);
                         for c in 0..3 {
                             sum[c] += f64::from(value[c]);
                         }
                     }
                 }
-            });
+                rays
+            })
+            .sum();
+        self.rays_traced += rays;
         self.samples_done += samples;
         let per_sample = started.elapsed().as_secs_f64() / f64::from(samples);
         self.batch_samples =

@@ -3,6 +3,15 @@
 // nearer child is visited first, the farther one pushed with its entry distance and skipped
 // on pop if a closer hit was found meanwhile.
 // CPU twin: `crates/core/src/trace.rs`.
+//
+// `ACCEL` (a pipeline constant) selects the seed's slower schemes for benchmarks: every object
+// in turn, a mesh's triangles tested only when the ray hits the mesh's bounding box
+// (ACCEL_BOUNDING_VOLUME) or always (ACCEL_BRUTE_FORCE). Each finds the same nearest hit.
+
+const ACCEL_BVH: u32 = 0u;
+const ACCEL_BOUNDING_VOLUME: u32 = 1u;
+const ACCEL_BRUTE_FORCE: u32 = 2u;
+override ACCEL: u32 = 0u;
 
 const STACK_SIZE: u32 = 64u;
 const NO_HIT: u32 = 0xffffffffu;
@@ -79,6 +88,25 @@ fn intersect_mesh(object: u32, root: u32, ray: Ray, inv_dir: vec3f, hit: ptr<fun
     }
 }
 
+// Nearest hit among a mesh's triangles without its BLAS (the slower `ACCEL` schemes).
+fn intersect_triangles(object: u32, o: Object, ray: Ray, inv_dir: vec3f, hit: ptr<function, Hit>) {
+    if ACCEL == ACCEL_BOUNDING_VOLUME && intersect_aabb(nodes[o.blas_root], ray.origin, inv_dir, (*hit).t) == MISS {
+        return;
+    }
+    for (var i = o.first_triangle; i < o.first_triangle + o.triangle_count; i++) {
+        let r = intersect_triangle(
+            vertices[3u * i].position,
+            vertices[3u * i + 1u].position,
+            vertices[3u * i + 2u].position,
+            ray,
+            (*hit).t,
+        );
+        if r.x < (*hit).t {
+            *hit = Hit(r.x, object, i, r.y, r.z);
+        }
+    }
+}
+
 // Nearest hit on object `i` (in top-level order), updating `hit`.
 fn intersect_object(i: u32, ray: Ray, inv_dir: vec3f, hit: ptr<function, Hit>) {
     let o = objects[i];
@@ -102,7 +130,11 @@ fn intersect_object(i: u32, ray: Ray, inv_dir: vec3f, hit: ptr<function, Hit>) {
             }
         }
         default: {
-            intersect_mesh(i, o.blas_root, ray, inv_dir, hit);
+            if ACCEL == ACCEL_BVH {
+                intersect_mesh(i, o.blas_root, ray, inv_dir, hit);
+            } else {
+                intersect_triangles(i, o, ray, inv_dir, hit);
+            }
         }
     }
 }
@@ -114,6 +146,12 @@ fn intersect_scene(ray: Ray, t_max: f32, object_count: u32) -> Hit {
         return hit;
     }
     let inv_dir = safe_inverse(ray.dir);
+    if ACCEL != ACCEL_BVH {
+        for (var i = 0u; i < object_count; i++) {
+            intersect_object(i, ray, inv_dir, &hit);
+        }
+        return hit;
+    }
     var stack_node: array<u32, STACK_SIZE>;
     var stack_t: array<f32, STACK_SIZE>;
     var sp = 0u;

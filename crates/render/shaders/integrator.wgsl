@@ -63,6 +63,13 @@ fn add_fixed(acc: ptr<function, AccumPixel>, x: AccumPixel) {
 
 @group(1) @binding(0) var<uniform> params: FrameParams;
 @group(1) @binding(1) var<storage, read_write> accum: array<AccumPixel>;
+// Rays traced since the counter was cleared, as a 64-bit count: [low word, high word].
+@group(1) @binding(2) var<storage, read_write> ray_counter: array<atomic<u32>, 2>;
+
+// Rays this invocation traced (camera, extension and shadow rays).
+var<private> rays_traced: u32;
+// Rays this workgroup traced, added to `ray_counter` once per workgroup.
+var<workgroup> workgroup_rays: atomic<u32>;
 
 const T_MAX: f32 = 1.0e30;
 
@@ -86,6 +93,7 @@ fn camera_ray(x: u32, y: u32, sampler: ptr<function, Sampler>) -> Ray {
 // ray runs from the offset origin to the light point, stopping just short of it.
 fn occluded(p: vec3f, ng: vec3f, ls: LightSample) -> bool {
     let origin = offset_origin(p, ng, ls.wi);
+    rays_traced++;
     if !ls.finite {
         return intersect_scene(Ray(origin, ls.wi), T_MAX, params.object_count).object != NO_HIT;
     }
@@ -109,6 +117,7 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
     var eta_scale = 1.0;
     for (var depth = 1u; depth <= params.max_depth; depth++) {
         let hit = intersect_scene(ray, T_MAX, params.object_count);
+        rays_traced++;
         if hit.object == NO_HIT {
             var w = 1.0;
             if !prev_delta {
@@ -176,22 +185,30 @@ fn is_finite3(v: vec3f) -> bool {
 }
 
 @compute @workgroup_size(8, 8)
-fn render(@builtin(global_invocation_id) gid: vec3u) {
+fn render(@builtin(global_invocation_id) gid: vec3u, @builtin(local_invocation_index) local: u32) {
     let x = gid.x;
     let y = gid.y + params.row_offset;
-    if x >= params.width || y >= params.row_end {
-        return;
+    if x < params.width && y < params.row_end {
+        let pixel = y * params.width + x;
+        var batch = AccumPixel(vec4u(0u), vec4u(0u));
+        for (var i = 0u; i < params.batch_samples; i++) {
+            var sampler = sampler_init(params.sampler, pixel, params.sample_offset + i, params.seed);
+            let radiance = trace_path(camera_ray(x, y, &sampler), &sampler);
+            if is_finite3(radiance) {
+                add_sample(&batch, radiance);
+            }
+        }
+        var total = accum[pixel];
+        add_fixed(&total, batch);
+        accum[pixel] = total;
     }
-    let pixel = y * params.width + x;
-    var batch = AccumPixel(vec4u(0u), vec4u(0u));
-    for (var i = 0u; i < params.batch_samples; i++) {
-        var sampler = sampler_init(params.sampler, pixel, params.sample_offset + i, params.seed);
-        let radiance = trace_path(camera_ray(x, y, &sampler), &sampler);
-        if is_finite3(radiance) {
-            add_sample(&batch, radiance);
+    atomicAdd(&workgroup_rays, rays_traced);
+    workgroupBarrier();
+    if local == 0u {
+        let n = atomicLoad(&workgroup_rays);
+        let old = atomicAdd(&ray_counter[0], n);
+        if old > 0xffffffffu - n {
+            atomicAdd(&ray_counter[1], 1u);
         }
     }
-    var total = accum[pixel];
-    add_fixed(&total, batch);
-    accum[pixel] = total;
 }

@@ -23,7 +23,8 @@ struct Object {
     light: u32,
     // Mesh: its first triangle index.
     first_triangle: u32,
-    pad: u32,
+    // Mesh: how many triangles it has.
+    triangle_count: u32,
 }
 
 const NO_LIGHT: u32 = 0xffffffffu;

@@ -9,4 +9,4 @@ pub mod shaders;
 pub use context::GpuContext;
 pub use error::RenderError;
 pub use pathlight_core::Film;
-pub use renderer::ProgressiveRenderer;
+pub use renderer::{Accel, ProgressiveRenderer};

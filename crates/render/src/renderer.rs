@@ -22,6 +22,34 @@ const MAX_BATCH_SAMPLES: u32 = 256;
 /// Workgroup edge of the integrator (`@workgroup_size(8, 8)`).
 const WORKGROUP: u32 = 8;
 
+/// How the integrator finds the nearest hit. Every scheme finds the same hit (a test checks
+/// it); the slower two reproduce the seed's frame-rate table (`pathlight bench --accel`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Accel {
+    /// The two-level BVH.
+    #[default]
+    Bvh,
+    /// Every object in turn; a mesh's triangles only when the ray hits its bounding box.
+    BoundingVolume,
+    /// Every object and every triangle in turn.
+    BruteForce,
+}
+
+impl Accel {
+    /// All schemes, fastest first.
+    pub const ALL: [Accel; 3] = [Accel::Bvh, Accel::BoundingVolume, Accel::BruteForce];
+
+    /// The shader's `ACCEL` pipeline constant selecting this scheme (`bvh.wgsl`).
+    pub fn pipeline_constants(self) -> [(&'static str, f64); 1] {
+        let value = match self {
+            Accel::Bvh => 0.0,
+            Accel::BoundingVolume => 1.0,
+            Accel::BruteForce => 2.0,
+        };
+        [("ACCEL", value)]
+    }
+}
+
 /// A scene on the device with its accumulation buffer.
 #[derive(Debug)]
 pub struct ProgressiveRenderer<'a> {
@@ -30,6 +58,8 @@ pub struct ProgressiveRenderer<'a> {
     pipeline: wgpu::ComputePipeline,
     params_buffer: wgpu::Buffer,
     accum_buffer: wgpu::Buffer,
+    /// Rays traced since the last restart (64-bit: low word, high word).
+    ray_counter: wgpu::Buffer,
     frame_bind_group: wgpu::BindGroup,
     params: GpuFrameParams,
     /// Samples per pixel accumulated so far.
@@ -47,6 +77,16 @@ impl<'a> ProgressiveRenderer<'a> {
         ctx: &'a GpuContext,
         scene: &Scene,
         gpu_scene: &GpuScene,
+    ) -> Result<Self, RenderError> {
+        Self::with_accel(ctx, scene, gpu_scene, Accel::Bvh)
+    }
+
+    /// [`Self::new`] with the given acceleration scheme.
+    pub fn with_accel(
+        ctx: &'a GpuContext,
+        scene: &Scene,
+        gpu_scene: &GpuScene,
+        accel: Accel,
     ) -> Result<Self, RenderError> {
         let device = &ctx.device;
         let params = frame_params(scene, gpu_scene);
@@ -77,6 +117,7 @@ impl<'a> ProgressiveRenderer<'a> {
                     count: None,
                 },
                 storage_entry(1, false),
+                storage_entry(2, false),
             ],
         });
         let pipeline = create_compute_pipeline(
@@ -85,6 +126,7 @@ impl<'a> ProgressiveRenderer<'a> {
             &shaders::integrator_module(),
             "render",
             &[&scene_buffers.layout, &frame_layout],
+            &accel.pipeline_constants(),
         )?;
         let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame params"),
@@ -95,6 +137,14 @@ impl<'a> ProgressiveRenderer<'a> {
         let accum_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("accumulation"),
             size: accum_size,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let ray_counter = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ray counter"),
+            size: size_of::<u64>() as u64,
             usage: wgpu::BufferUsages::STORAGE
                 | wgpu::BufferUsages::COPY_SRC
                 | wgpu::BufferUsages::COPY_DST,
@@ -112,6 +162,10 @@ impl<'a> ProgressiveRenderer<'a> {
                     binding: 1,
                     resource: accum_buffer.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: ray_counter.as_entire_binding(),
+                },
             ],
         });
         Ok(Self {
@@ -120,6 +174,7 @@ impl<'a> ProgressiveRenderer<'a> {
             pipeline,
             params_buffer,
             accum_buffer,
+            ray_counter,
             frame_bind_group,
             rows_per_dispatch: params.height.min(WORKGROUP * 4),
             batch_samples: 1,
@@ -164,32 +219,7 @@ impl<'a> ProgressiveRenderer<'a> {
         let mut row = 0;
         while row < height {
             let rows = self.rows_per_dispatch.min(height - row);
-            let params = GpuFrameParams {
-                sample_offset: self.samples_done,
-                batch_samples: samples,
-                row_offset: row,
-                row_end: row + rows,
-                ..self.params
-            };
-            self.ctx
-                .queue
-                .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
-            let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-            {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("integrator"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(&self.pipeline);
-                pass.set_bind_group(0, &self.scene.bind_group, &[]);
-                pass.set_bind_group(1, &self.frame_bind_group, &[]);
-                pass.dispatch_workgroups(
-                    self.params.width.div_ceil(WORKGROUP),
-                    rows.div_ceil(WORKGROUP),
-                    1,
-                );
-            }
-            self.ctx.queue.submit([encoder.finish()]);
+            self.submit(row, rows, samples);
             self.wait()?;
             row += rows;
         }
@@ -198,6 +228,63 @@ impl<'a> ProgressiveRenderer<'a> {
             self.reschedule(started.elapsed(), samples);
         }
         Ok(samples)
+    }
+
+    /// Queues one frame (one sample per pixel over the whole image, one dispatch) without
+    /// waiting for it; [`Self::finish`] waits. This is the benchmark's unit of work.
+    pub fn submit_frame(&mut self) {
+        self.submit(0, self.params.height, 1);
+        self.samples_done += 1;
+    }
+
+    /// Waits until every queued frame has finished.
+    pub fn finish(&self) -> Result<(), RenderError> {
+        self.wait()
+    }
+
+    /// Queues `samples` samples per pixel for rows `row .. row + rows`.
+    fn submit(&self, row: u32, rows: u32, samples: u32) {
+        let params = GpuFrameParams {
+            sample_offset: self.samples_done,
+            batch_samples: samples,
+            row_offset: row,
+            row_end: row + rows,
+            ..self.params
+        };
+        self.ctx
+            .queue
+            .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("integrator"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.scene.bind_group, &[]);
+            pass.set_bind_group(1, &self.frame_bind_group, &[]);
+            pass.dispatch_workgroups(
+                self.params.width.div_ceil(WORKGROUP),
+                rows.div_ceil(WORKGROUP),
+                1,
+            );
+        }
+        self.ctx.queue.submit([encoder.finish()]);
+    }
+
+    /// Empties the image and the ray count (the next sample is sample 0 again).
+    pub fn restart(&mut self) {
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        encoder.clear_buffer(&self.accum_buffer, 0, None);
+        encoder.clear_buffer(&self.ray_counter, 0, None);
+        self.ctx.queue.submit([encoder.finish()]);
+        self.samples_done = 0;
+    }
+
+    /// Rays traced (camera, extension and shadow rays) since the start or the last restart.
+    pub fn rays_traced(&self) -> Result<u64, RenderError> {
+        let words: Vec<u32> = self.read_buffer(&self.ray_counter)?;
+        Ok(u64::from(words[0]) | (u64::from(words[1]) << 32))
     }
 
     /// Sizes the next pieces from the speed of the last `advance`.
@@ -220,18 +307,18 @@ impl<'a> ProgressiveRenderer<'a> {
         }
     }
 
-    /// Copies the accumulation back and divides by the sample count.
-    pub fn read_film(&self) -> Result<Film, RenderError> {
+    /// Copies a buffer back to the host.
+    fn read_buffer<T: bytemuck::Pod>(&self, buffer: &wgpu::Buffer) -> Result<Vec<T>, RenderError> {
         let device = &self.ctx.device;
-        let size = self.accum_buffer.size();
+        let size = buffer.size();
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("accumulation readback"),
+            label: Some("readback"),
             size,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let mut encoder = device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(&self.accum_buffer, 0, &staging, 0, size);
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
         self.ctx.queue.submit([encoder.finish()]);
         let slice = staging.slice(..);
         let (sender, receiver) = std::sync::mpsc::channel();
@@ -246,7 +333,12 @@ impl<'a> ProgressiveRenderer<'a> {
         let view = slice
             .get_mapped_range()
             .map_err(|err| RenderError::Gpu(err.to_string()))?;
-        let accum: &[GpuAccumPixel] = bytemuck::cast_slice(&view);
+        Ok(bytemuck::cast_slice(&view).to_vec())
+    }
+
+    /// Copies the accumulation back and divides by the sample count.
+    pub fn read_film(&self) -> Result<Film, RenderError> {
+        let accum: Vec<GpuAccumPixel> = self.read_buffer(&self.accum_buffer)?;
         let scale = 1.0 / f64::from(self.samples_done.max(1));
         let pixels = accum
             .iter()

@@ -79,13 +79,15 @@ impl SceneBuffers {
     }
 }
 
-/// Creates a compute pipeline inside an error scope so a shader mismatch is an error.
+/// Creates a compute pipeline inside an error scope so a shader mismatch is an error;
+/// `constants` sets the shader's pipeline-overridable constants by name.
 pub fn create_compute_pipeline(
     device: &wgpu::Device,
     label: &str,
     source: &str,
     entry_point: &str,
     layouts: &[&wgpu::BindGroupLayout],
+    constants: &[(&str, f64)],
 ) -> Result<wgpu::ComputePipeline, RenderError> {
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -104,7 +106,10 @@ pub fn create_compute_pipeline(
         layout: Some(&pipeline_layout),
         module: &module,
         entry_point: Some(entry_point),
-        compilation_options: Default::default(),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants,
+            ..Default::default()
+        },
         cache: None,
     });
     match pollster::block_on(scope.pop()) {

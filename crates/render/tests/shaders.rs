@@ -91,7 +91,8 @@ fn host_structs_match_their_wgsl_declarations() {
             id,
             flags,
             light,
-            first_triangle
+            first_triangle,
+            triangle_count
         ]
     );
     assert_layout!(m, "Light", GpuLight, [object, primitive, cdf, pmf]);

@@ -105,7 +105,7 @@ fn extreme_values_give_finite_samples_on_both_backends() {
             for i in 0..16 {
                 let mut sampler = Sampler::new(params.sampler, y * 32 + x, i, params.seed);
                 let ray = camera_ray(&params, x, y, &mut sampler);
-                let l = trace_path(&gpu_scene, &params, ray, &mut sampler);
+                let l = trace_path(&gpu_scene, &params, ray, &mut sampler).radiance;
                 assert!(
                     l.is_finite() && l.min_element() >= 0.0,
                     "pixel ({x}, {y}) sample {i}: {l}"

@@ -7,6 +7,7 @@ use glam::Vec3;
 use pathlight_core::gpu::KIND_MESH;
 use pathlight_core::trace::Ray;
 use pathlight_core::{GpuScene, default_scene};
+use pathlight_render::Accel;
 use pathlight_render::scene_buffers::{SceneBuffers, create_compute_pipeline, storage_entry};
 use pathlight_render::shaders;
 use rand::rngs::StdRng;
@@ -50,7 +51,7 @@ struct TraceHit {
     pad: u32,
 }
 
-fn trace_on_gpu(gpu_scene: &GpuScene, rays: &[TraceRay]) -> Vec<TraceHit> {
+fn trace_on_gpu(gpu_scene: &GpuScene, rays: &[TraceRay], accel: Accel) -> Vec<TraceHit> {
     let ctx = context();
     let device = &ctx.device;
     let scene = SceneBuffers::upload(device, gpu_scene).unwrap();
@@ -70,6 +71,7 @@ fn trace_on_gpu(gpu_scene: &GpuScene, rays: &[TraceRay]) -> Vec<TraceHit> {
         &source,
         "trace",
         &[&scene.layout, &layout],
+        &accel.pipeline_constants(),
     )
     .unwrap();
     let ray_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -122,6 +124,7 @@ fn trace_on_gpu(gpu_scene: &GpuScene, rays: &[TraceRay]) -> Vec<TraceHit> {
     bytemuck::cast_slice(&view).to_vec()
 }
 
+/// Every acceleration scheme finds what the CPU twin finds.
 #[test]
 fn wgsl_traversal_matches_cpu_twin() {
     let scene = default_scene::load().unwrap();
@@ -155,9 +158,19 @@ fn wgsl_traversal_matches_cpu_twin() {
             }
         })
         .collect();
-    let hits = trace_on_gpu(&gpu_scene, &rays);
+    for accel in Accel::ALL {
+        check_hits(
+            &gpu_scene,
+            &rays,
+            &trace_on_gpu(&gpu_scene, &rays, accel),
+            accel,
+        );
+    }
+}
+
+fn check_hits(gpu_scene: &GpuScene, rays: &[TraceRay], hits: &[TraceHit], accel: Accel) {
     let (mut hit_count, mut mesh_hits, mut mismatches) = (0, 0, 0);
-    for (ray, gpu) in rays.iter().zip(&hits) {
+    for (ray, gpu) in rays.iter().zip(hits) {
         let cpu = gpu_scene.intersect(
             &Ray {
                 origin: ray.origin.into(),
@@ -169,13 +182,13 @@ fn wgsl_traversal_matches_cpu_twin() {
             None => assert_eq!(
                 gpu.object,
                 u32::MAX,
-                "GPU hit {gpu:?} where the CPU twin misses"
+                "{accel:?}: GPU hit {gpu:?} where the CPU twin misses"
             ),
             Some(cpu) => {
                 hit_count += 1;
                 assert!(
                     (gpu.t - cpu.t).abs() <= 1e-4 * cpu.t.max(1.0),
-                    "t: GPU {gpu:?}, CPU {cpu:?}"
+                    "{accel:?}: t: GPU {gpu:?}, CPU {cpu:?}"
                 );
                 if (gpu.object, gpu.primitive) != (cpu.object, cpu.primitive) {
                     // Only a ray through a shared edge may pick either neighbour.
@@ -187,10 +200,10 @@ fn wgsl_traversal_matches_cpu_twin() {
     }
     assert!(
         hit_count > 10_000 && mesh_hits > 200,
-        "{hit_count} hits, {mesh_hits} on the vase"
+        "{accel:?}: {hit_count} hits, {mesh_hits} on the vase"
     );
     assert!(
         mismatches <= 5,
-        "{mismatches} rays hit a different primitive on the GPU"
+        "{accel:?}: {mismatches} rays hit a different primitive on the GPU"
     );
 }
