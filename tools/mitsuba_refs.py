@@ -13,6 +13,10 @@ constant environment) to a Mitsuba scene and either
                                          prints Mitsuba's own relMSE against the stored
                                          reference: mean over pixels and channels of
                                          (test - ref)^2 / (ref^2 + 0.01), ref box-downsampled
+  time NAME... [--res 512] [--spp 64] [--repeats 3]
+                                         render time alone (after one untimed render that
+                                         compiles the kernels), median of the repeats, and
+                                         samples/s
 
 Needs: pip install mitsuba numpy; apt-get install libllvm19 (for llvm_ad_rgb, the default
 variant; DRJIT_LIBLLVM_PATH is set to Debian's libLLVM.so.19.1 when it exists).
@@ -144,11 +148,12 @@ def downsample(image, size):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("command", choices=["render", "relmse"])
+    ap.add_argument("command", choices=["render", "relmse", "time"])
     ap.add_argument("names", nargs="+")
     ap.add_argument("--res", type=int)
     ap.add_argument("--spp", type=int)
     ap.add_argument("--seeds", type=int, default=8)
+    ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--variant", default="llvm_ad_rgb")
     a = ap.parse_args()
     import mitsuba as mi
@@ -167,6 +172,19 @@ def main():
                 mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.UInt8, srgb_gamma=True).write(exr[:-4] + ".png")
             print(json.dumps({"scene": name, "variant": a.variant, "res": res, "spp": spp,
                               "seconds": round(time.perf_counter() - t0, 1), "exr": exr}), flush=True)
+        elif a.command == "time":
+            res, spp = a.res or 512, a.spp or 64
+            mts = mi.load_dict(to_mitsuba(scene, res, spp))
+            np.asarray(mi.render(mts, spp=spp, seed=0))
+            times = []
+            for seed in range(1, a.repeats + 1):
+                t0 = time.perf_counter()
+                np.asarray(mi.render(mts, spp=spp, seed=seed))
+                times.append(time.perf_counter() - t0)
+            seconds = float(np.median(times))
+            print(json.dumps({"scene": name, "variant": a.variant, "res": res, "spp": spp,
+                              "seconds": [round(t, 3) for t in times], "median_seconds": round(seconds, 3),
+                              "samples_per_second": round(res * res * spp / seconds)}), flush=True)
         else:
             res, spp = a.res or 128, a.spp or 64
             ref = downsample(np.asarray(mi.Bitmap(os.path.join(REFS, "images", name + ".exr")), np.float64)[..., :3], res)

@@ -9,9 +9,9 @@ use clap::{Parser, Subcommand, ValueEnum};
 #[derive(Debug, Parser)]
 #[command(version, about)]
 pub struct Cli {
-    /// What to do.
+    /// What to do; without one, `view` on a machine with a display.
     #[command(subcommand)]
-    pub command: Command,
+    pub command: Option<Command>,
 }
 
 /// The subcommands.
@@ -19,6 +19,8 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene headless to a PNG or EXR file.
     Render(RenderArgs),
+    /// Open the interactive viewer (a window that refines the picture while you watch).
+    View(ViewArgs),
     /// Measure frames per second, samples/s and rays/s (one sample per pixel per frame).
     Bench(BenchArgs),
 }
@@ -128,4 +130,48 @@ pub struct BenchArgs {
     /// Print the results as JSON on standard output instead of a table.
     #[arg(long)]
     pub json: bool,
+}
+
+/// Options of `pathlight view`.
+#[derive(Debug, clap::Args)]
+pub struct ViewArgs {
+    #[command(flatten)]
+    #[allow(missing_docs)]
+    pub scene: SceneArgs,
+    /// Frames per iteration (one sample per pixel each).
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
+    pub frames_per_iter: u32,
+    /// Number of iterations; a right click starts each after the first.
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..))]
+    pub iters: u32,
+    /// Emitted radiance of a clicked object per unit of its base colour (default: the
+    /// brightest emission in the scene).
+    #[arg(long, value_name = "STRENGTH")]
+    pub light_strength: Option<f32>,
+    /// Where `S` saves images.
+    #[arg(long, default_value = ".", value_name = "DIR")]
+    pub save_dir: PathBuf,
+    /// Use the adapter whose name contains this text (any case), or a backend name.
+    #[arg(long, value_name = "NAME")]
+    pub adapter: Option<String>,
+}
+
+impl ViewArgs {
+    /// The options of a bare `pathlight`: the default scene with default settings.
+    pub fn defaults() -> Self {
+        Self {
+            scene: SceneArgs {
+                scene: None,
+                width: None,
+                height: None,
+                seed: None,
+                max_depth: None,
+            },
+            frames_per_iter: 512,
+            iters: 8,
+            light_strength: None,
+            save_dir: ".".into(),
+            adapter: None,
+        }
+    }
 }

@@ -8,6 +8,7 @@ mod output;
 mod progress;
 mod render_cmd;
 mod setup;
+mod view;
 
 use std::process::ExitCode;
 
@@ -20,8 +21,10 @@ fn main() -> ExitCode {
     .init();
     let cli = cli::Cli::parse();
     let result = match cli.command {
-        cli::Command::Render(args) => render_cmd::run(&args),
-        cli::Command::Bench(args) => bench_cmd::run(&args),
+        Some(cli::Command::Render(args)) => render_cmd::run(&args),
+        Some(cli::Command::View(args)) => view::run(&args),
+        Some(cli::Command::Bench(args)) => bench_cmd::run(&args),
+        None => view::run(&cli::ViewArgs::defaults()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -50,18 +50,20 @@ pub fn device_name(ctx: Option<&GpuContext>) -> String {
     }
 }
 
-/// A progressive renderer on either backend.
-pub enum Renderer<'a> {
+/// A progressive renderer on either backend. (One per command: the variants' sizes do not
+/// matter.)
+#[allow(clippy::large_enum_variant)]
+pub enum Renderer {
     /// WGSL on a wgpu adapter.
-    Gpu(ProgressiveRenderer<'a>),
+    Gpu(ProgressiveRenderer),
     /// The native CPU twin.
     Cpu(CpuRenderer),
 }
 
-impl<'a> Renderer<'a> {
+impl Renderer {
     /// Prepares `scene` on the context's adapter, or on the CPU when there is none.
     pub fn new(
-        ctx: Option<&'a GpuContext>,
+        ctx: Option<&GpuContext>,
         scene: &Scene,
         gpu_scene: GpuScene,
         accel: Accel,

@@ -220,3 +220,23 @@ fn list_adapters_names_one() {
     assert!(output.status.success());
     assert!(!String::from_utf8_lossy(&output.stdout).trim().is_empty());
 }
+
+/// Without a display, `pathlight view` (and a bare `pathlight`) says so and points to
+/// `pathlight render`, without opening anything.
+#[test]
+fn viewer_without_a_display_suggests_render() {
+    for args in [&["view"][..], &[]] {
+        let output = Command::new(env!("CARGO_BIN_EXE_pathlight"))
+            .args(args)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap();
+        let err = stderr(&output);
+        assert_eq!(output.status.code(), Some(1), "{args:?}:\n{err}");
+        assert!(
+            err.contains("no display") && err.contains("pathlight render"),
+            "{args:?}:\n{err}"
+        );
+    }
+}

@@ -37,6 +37,21 @@ impl Texture {
     }
 }
 
+impl Texture {
+    /// The mean linear colour of its texels.
+    pub fn mean_linear(&self) -> glam::Vec3 {
+        let sum = self.texels.iter().fold(glam::DVec3::ZERO, |acc, &t| {
+            let [r, g, b, _] = t.to_le_bytes();
+            acc + glam::DVec3::new(
+                f64::from(srgb_to_linear(f32::from(r) / 255.0)),
+                f64::from(srgb_to_linear(f32::from(g) / 255.0)),
+                f64::from(srgb_to_linear(f32::from(b) / 255.0)),
+            )
+        });
+        (sum / self.texels.len().max(1) as f64).as_vec3()
+    }
+}
+
 /// The sRGB transfer function's inverse: encoded [0, 1] to linear.
 pub fn srgb_to_linear(c: f32) -> f32 {
     if c <= 0.04045 {

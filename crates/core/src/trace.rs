@@ -4,7 +4,7 @@
 use glam::Vec3;
 
 use crate::accel::GpuScene;
-use crate::gpu::{FLAG_CAPS, GpuBvhNode, KIND_CYLINDER, KIND_QUAD, KIND_SPHERE};
+use crate::gpu::{FLAG_CAPS, GpuBvhNode, KIND_MESH, KIND_QUAD, KIND_SPHERE};
 
 /// Distance returned when there is no hit (WGSL `MISS`).
 pub const MISS: f32 = 3.0e38;
@@ -178,60 +178,15 @@ pub fn intersect_triangle(v0: Vec3, v1: Vec3, v2: Vec3, ray: &Ray, t_max: f32) -
     (t, b1, b2)
 }
 
-/// Ordered stack traversal of the BVH rooted at `root`; `leaf` intersects one leaf's
-/// primitives and updates the hit. Twin of the loops in WGSL `intersect_mesh` and
-/// `intersect_scene`.
-fn traverse(
-    nodes: &[GpuBvhNode],
-    root: u32,
-    ray: &Ray,
-    inv_dir: Vec3,
-    hit: &mut Hit,
-    mut leaf: impl FnMut(&GpuBvhNode, &mut Hit),
-) {
-    let mut stack = [(0u32, 0.0f32); STACK_SIZE];
-    let mut sp = 0;
-    let mut index = root;
-    if intersect_aabb(&nodes[root as usize], ray.origin, inv_dir, hit.t) == MISS {
-        return;
-    }
-    loop {
-        let node = &nodes[index as usize];
-        let mut descend = false;
-        if node.prim_count > 0 {
-            leaf(node, hit);
-        } else {
-            let a = node.first_index;
-            let ta = intersect_aabb(&nodes[a as usize], ray.origin, inv_dir, hit.t);
-            let tb = intersect_aabb(&nodes[a as usize + 1], ray.origin, inv_dir, hit.t);
-            if ta != MISS && tb != MISS {
-                let (near, far) = if ta <= tb { (a, a + 1) } else { (a + 1, a) };
-                index = near;
-                if sp < STACK_SIZE {
-                    stack[sp] = (far, ta.max(tb));
-                    sp += 1;
-                }
-                descend = true;
-            } else if ta != MISS || tb != MISS {
-                index = if ta != MISS { a } else { a + 1 };
-                descend = true;
-            }
-        }
-        if !descend {
-            let mut found = false;
-            while sp > 0 {
-                sp -= 1;
-                if stack[sp].1 < hit.t {
-                    index = stack[sp].0;
-                    found = true;
-                    break;
-                }
-            }
-            if !found {
-                break;
-            }
-        }
-    }
+/// A traversal stack entry (WGSL packs these into tagged `u32`s).
+#[derive(Debug, Clone, Copy)]
+enum Entry {
+    /// A node to visit.
+    Node(u32),
+    /// A mesh object whose BLAS is still to be walked (WGSL `ENTER_MESH`).
+    EnterMesh(u32),
+    /// The end of the BLAS being walked (WGSL `LEAVE_MESH`).
+    LeaveMesh,
 }
 
 impl GpuScene {
@@ -241,59 +196,58 @@ impl GpuScene {
         [0, 1, 2].map(|k| Vec3::from(self.vertices[i + k].position))
     }
 
-    /// Nearest hit on object `i` (top-level order), updating `hit`; twin of WGSL
-    /// `intersect_object`.
-    pub fn intersect_object(&self, i: u32, ray: &Ray, inv_dir: Vec3, hit: &mut Hit) {
+    /// Nearest hit on quad, sphere or cylinder `i` (top-level order), updating `hit`; twin
+    /// of WGSL `intersect_shape`.
+    pub fn intersect_shape(&self, i: u32, ray: &Ray, hit: &mut Hit) {
         let o = &self.objects[i as usize];
         let a = Vec3::from_slice(&o.a);
-        let b = Vec3::from_slice(&o.b);
-        let c = Vec3::from_slice(&o.c);
-        let simple = |t: f32, b1: f32, b2: f32, hit: &mut Hit| {
+        let (t, b1, b2) = match o.kind {
+            KIND_QUAD => intersect_quad(
+                a,
+                Vec3::from_slice(&o.b),
+                Vec3::from_slice(&o.c),
+                ray,
+                hit.t,
+            ),
+            KIND_SPHERE => (intersect_sphere(a, o.a[3], ray, hit.t), 0.0, 0.0),
+            _ => {
+                let caps = o.flags & FLAG_CAPS != 0;
+                let t = intersect_cylinder(a, Vec3::from_slice(&o.b), o.a[3], caps, ray, hit.t);
+                (t, 0.0, 0.0)
+            }
+        };
+        if t < hit.t {
+            *hit = Hit {
+                t,
+                object: i,
+                primitive: 0,
+                b1,
+                b2,
+            };
+        }
+    }
+
+    /// Nearest hit among triangles `first .. first + count` of mesh object `object`; twin of
+    /// WGSL `intersect_triangles`.
+    fn intersect_triangles(&self, object: u32, first: u32, count: u32, ray: &Ray, hit: &mut Hit) {
+        for tri in first..first + count {
+            let [v0, v1, v2] = self.triangle(tri);
+            let (t, b1, b2) = intersect_triangle(v0, v1, v2, ray, hit.t);
             if t < hit.t {
                 *hit = Hit {
                     t,
-                    object: i,
-                    primitive: 0,
+                    object,
+                    primitive: tri,
                     b1,
                     b2,
                 };
             }
-        };
-        match o.kind {
-            KIND_QUAD => {
-                let (t, s, r) = intersect_quad(a, b, c, ray, hit.t);
-                simple(t, s, r, hit);
-            }
-            KIND_SPHERE => simple(intersect_sphere(a, o.a[3], ray, hit.t), 0.0, 0.0, hit),
-            KIND_CYLINDER => {
-                let caps = o.flags & FLAG_CAPS != 0;
-                simple(
-                    intersect_cylinder(a, b, o.a[3], caps, ray, hit.t),
-                    0.0,
-                    0.0,
-                    hit,
-                );
-            }
-            _ => traverse(&self.nodes, o.blas_root, ray, inv_dir, hit, |node, hit| {
-                for tri in node.first_index..node.first_index + node.prim_count {
-                    let [v0, v1, v2] = self.triangle(tri);
-                    let (t, b1, b2) = intersect_triangle(v0, v1, v2, ray, hit.t);
-                    if t < hit.t {
-                        *hit = Hit {
-                            t,
-                            object: i,
-                            primitive: tri,
-                            b1,
-                            b2,
-                        };
-                    }
-                }
-            }),
         }
     }
 
-    /// Nearest hit in `(0, t_max)`; twin of WGSL `intersect_scene`.
-    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+    /// Nearest hit in `(0, t_max)`, or with `any_hit` the first one found: one ordered
+    /// stack walk over both levels. Twin of WGSL `trace_scene` (its BVH scheme).
+    fn trace(&self, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
         let mut hit = Hit {
             t: t_max,
             object: u32::MAX,
@@ -301,15 +255,98 @@ impl GpuScene {
             b1: 0.0,
             b2: 0.0,
         };
-        if self.object_count == 0 {
-            return None;
-        }
+        let nodes = &self.nodes;
         let inv_dir = safe_inverse(ray.dir);
-        traverse(&self.nodes, 0, ray, inv_dir, &mut hit, |node, hit| {
-            for i in node.first_index..node.first_index + node.prim_count {
-                self.intersect_object(i, ray, inv_dir, hit);
+        if self.object_count == 0 || intersect_aabb(&nodes[0], ray.origin, inv_dir, hit.t) == MISS {
+            return hit;
+        }
+        let mut stack = [(Entry::Node(0), 0.0f32); STACK_SIZE];
+        let mut sp = 0;
+        let mut index = 0u32;
+        // The mesh whose BLAS is being walked, if any.
+        let mut mesh: Option<u32> = None;
+        loop {
+            let node = &nodes[index as usize];
+            let mut descend = false;
+            if node.prim_count > 0 {
+                let (first, count) = (node.first_index, node.prim_count);
+                match mesh {
+                    Some(object) => self.intersect_triangles(object, first, count, ray, &mut hit),
+                    None => {
+                        for i in first..first + count {
+                            let o = &self.objects[i as usize];
+                            if o.kind != KIND_MESH {
+                                self.intersect_shape(i, ray, &mut hit);
+                            } else if sp < STACK_SIZE {
+                                let root = &nodes[o.blas_root as usize];
+                                let t = intersect_aabb(root, ray.origin, inv_dir, hit.t);
+                                if t != MISS {
+                                    stack[sp] = (Entry::EnterMesh(i), t);
+                                    sp += 1;
+                                }
+                            }
+                        }
+                    }
+                }
+                if any_hit && hit.object != u32::MAX {
+                    break;
+                }
+            } else {
+                let a = node.first_index;
+                let ta = intersect_aabb(&nodes[a as usize], ray.origin, inv_dir, hit.t);
+                let tb = intersect_aabb(&nodes[a as usize + 1], ray.origin, inv_dir, hit.t);
+                if ta != MISS && tb != MISS {
+                    let (near, far) = if ta <= tb { (a, a + 1) } else { (a + 1, a) };
+                    index = near;
+                    if sp < STACK_SIZE {
+                        stack[sp] = (Entry::Node(far), ta.max(tb));
+                        sp += 1;
+                    }
+                    descend = true;
+                } else if ta != MISS || tb != MISS {
+                    index = if ta != MISS { a } else { a + 1 };
+                    descend = true;
+                }
             }
-        });
+            if !descend {
+                let mut found = false;
+                while sp > 0 {
+                    sp -= 1;
+                    let (entry, t) = stack[sp];
+                    match entry {
+                        Entry::LeaveMesh => mesh = None,
+                        _ if t >= hit.t => {}
+                        Entry::EnterMesh(object) => {
+                            mesh = Some(object);
+                            index = self.objects[object as usize].blas_root;
+                            stack[sp] = (Entry::LeaveMesh, 0.0);
+                            sp += 1;
+                            found = true;
+                            break;
+                        }
+                        Entry::Node(node) => {
+                            index = node;
+                            found = true;
+                            break;
+                        }
+                    }
+                }
+                if !found {
+                    break;
+                }
+            }
+        }
+        hit
+    }
+
+    /// Nearest hit in `(0, t_max)`; twin of WGSL `intersect_scene`.
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let hit = self.trace(ray, t_max, false);
         (hit.object != u32::MAX).then_some(hit)
+    }
+
+    /// Whether anything lies on the ray in `(0, t_max)`; twin of WGSL `any_hit_scene`.
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        self.trace(ray, t_max, true).object != u32::MAX
     }
 }

@@ -4,7 +4,7 @@
 use glam::{Vec2, Vec3};
 use pathlight_core::gpu::{GpuBvhNode, KIND_MESH};
 use pathlight_core::scene::{Camera, Lobes, Material, RenderSettings, TriangleMesh};
-use pathlight_core::trace::{Hit, Ray, intersect_triangle, safe_inverse};
+use pathlight_core::trace::{Hit, Ray, intersect_triangle};
 use pathlight_core::{GpuScene, Object, Scene, Shape};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
@@ -151,7 +151,6 @@ fn validate(gpu: &GpuScene) {
 
 /// The nearest hit over every object and every triangle, without the BVH.
 fn brute_force(gpu: &GpuScene, ray: &Ray, t_max: f32) -> Option<Hit> {
-    let inv_dir = safe_inverse(ray.dir);
     let mut hit = Hit {
         t: t_max,
         object: u32::MAX,
@@ -168,21 +167,13 @@ fn brute_force(gpu: &GpuScene, ray: &Ray, t_max: f32) -> Option<Hit> {
         if o.kind == KIND_MESH {
             continue;
         }
-        gpu.intersect_object(i as u32, ray, inv_dir, &mut hit);
+        gpu.intersect_shape(i as u32, ray, &mut hit);
     }
-    let mesh_objects: Vec<(u32, u32)> = gpu
-        .objects
-        .iter()
-        .enumerate()
-        .filter(|(_, o)| o.kind == KIND_MESH)
-        .map(|(i, o)| (i as u32, o.blas_root))
-        .collect();
     for tri in 0..(gpu.vertices.len() / 3) as u32 {
         let [v0, v1, v2] = gpu.triangle(tri);
         let (t, b1, b2) = intersect_triangle(v0, v1, v2, ray, hit.t);
         if t < hit.t {
-            // Find the mesh whose BLAS range holds this triangle: the last root whose first leaf is <= tri.
-            let object = owner_of(gpu, &mesh_objects, tri);
+            let object = owner_of(gpu, tri);
             hit = Hit {
                 t,
                 object,
@@ -195,25 +186,21 @@ fn brute_force(gpu: &GpuScene, ray: &Ray, t_max: f32) -> Option<Hit> {
     (hit.object != u32::MAX).then_some(hit)
 }
 
-fn owner_of(gpu: &GpuScene, meshes: &[(u32, u32)], tri: u32) -> u32 {
-    fn leaves(gpu: &GpuScene, index: u32, out: &mut Vec<u32>) {
-        let n = gpu.nodes[index as usize];
-        if n.prim_count == 0 {
-            leaves(gpu, n.first_index, out);
-            leaves(gpu, n.first_index + 1, out);
-        } else {
-            out.extend(n.first_index..n.first_index + n.prim_count);
-        }
-    }
-    meshes
-        .iter()
-        .find(|(_, root)| {
-            let mut tris = Vec::new();
-            leaves(gpu, *root, &mut tris);
-            tris.contains(&tri)
+/// The mesh object whose triangle range holds triangle `tri`.
+fn owner_of(gpu: &GpuScene, tri: u32) -> u32 {
+    let owners: Vec<u32> = (0..gpu.object_count)
+        .filter(|&i| {
+            let o = &gpu.objects[i as usize];
+            o.kind == KIND_MESH
+                && (o.first_triangle..o.first_triangle + o.triangle_count).contains(&tri)
         })
-        .map(|(i, _)| *i)
-        .expect("every triangle belongs to a mesh")
+        .collect();
+    assert_eq!(
+        owners.len(),
+        1,
+        "triangle {tri} belongs to exactly one mesh"
+    );
+    owners[0]
 }
 
 /// A ray from anywhere in a 10-unit cube towards a point within `target` of the origin.
@@ -230,6 +217,15 @@ fn assert_same(gpu: &GpuScene, rays: &[Ray]) -> usize {
     for ray in rays {
         let fast = gpu.intersect(ray, 1e30);
         let slow = brute_force(gpu, ray, 1e30);
+        // The shadow-ray query: blocked exactly when the nearest hit lies before t_max.
+        for t_max in [0.5, 2.0, 1e30] {
+            let blocked = slow.is_some_and(|h| h.t < t_max);
+            assert_eq!(
+                gpu.occluded(ray, t_max),
+                blocked,
+                "ray {ray:?}, t_max {t_max}"
+            );
+        }
         match (fast, slow) {
             (None, None) => {}
             (Some(a), Some(b)) => {

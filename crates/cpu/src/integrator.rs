@@ -43,9 +43,7 @@ pub fn camera_ray(params: &GpuFrameParams, x: u32, y: u32, sampler: &mut Sampler
 fn occluded(scene: &GpuScene, p: Vec3, ng: Vec3, ls: &LightSample) -> bool {
     let origin = offset_origin(p, ng, ls.wi);
     if !ls.finite {
-        return scene
-            .intersect(&Ray { origin, dir: ls.wi }, T_MAX)
-            .is_some();
+        return scene.occluded(&Ray { origin, dir: ls.wi }, T_MAX);
     }
     let to_light = ls.point - origin;
     let distance = to_light.length();
@@ -53,7 +51,7 @@ fn occluded(scene: &GpuScene, p: Vec3, ng: Vec3, ls: &LightSample) -> bool {
         origin,
         dir: to_light / distance,
     };
-    scene.intersect(&ray, distance * (1.0 - 1e-4)).is_some()
+    scene.occluded(&ray, distance * (1.0 - 1e-4))
 }
 
 /// What one camera path brought back.

@@ -1,7 +1,9 @@
 // Two-level BVH traversal: the top level over objects, a BLAS per mesh, both obvhs BVH2s in
-// `nodes` (see `crates/core/src/accel.rs`). Ordered depth-first with an explicit stack: the
-// nearer child is visited first, the farther one pushed with its entry distance and skipped
-// on pop if a closer hit was found meanwhile.
+// `nodes` (see `crates/core/src/accel.rs`). Ordered depth-first with one explicit stack for
+// both levels: the nearer child is visited first, the farther one pushed with its entry
+// distance and skipped on pop if a closer hit was found meanwhile. A mesh met in a top-level
+// leaf is pushed as an ENTER_MESH entry; popping it pushes a LEAVE_MESH marker and walks the
+// mesh's BLAS, whose entries all lie above the marker. Shadow rays stop at the first hit.
 // CPU twin: `crates/core/src/trace.rs`.
 //
 // `ACCEL` (a pipeline constant) selects the seed's slower schemes for benchmarks: every object
@@ -15,6 +17,10 @@ override ACCEL: u32 = 0u;
 
 const STACK_SIZE: u32 = 64u;
 const NO_HIT: u32 = 0xffffffffu;
+// Stack entry tags: an object whose BLAS is still to be walked (its index in the low bits),
+// and the end of the BLAS being walked.
+const ENTER_MESH: u32 = 0x80000000u;
+const LEAVE_MESH: u32 = 0xffffffffu;
 
 struct Hit {
     t: f32,
@@ -27,89 +33,8 @@ struct Hit {
     b2: f32,
 }
 
-// Nearest hit among the triangles under BLAS `root`, updating `hit`.
-fn intersect_mesh(object: u32, root: u32, ray: Ray, inv_dir: vec3f, hit: ptr<function, Hit>) {
-    var stack_node: array<u32, STACK_SIZE>;
-    var stack_t: array<f32, STACK_SIZE>;
-    var sp = 0u;
-    var index = root;
-    if intersect_aabb(nodes[root], ray.origin, inv_dir, (*hit).t) == MISS {
-        return;
-    }
-    loop {
-        let node = nodes[index];
-        var descend = false;
-        if node.prim_count > 0u {
-            for (var i = node.first_index; i < node.first_index + node.prim_count; i++) {
-                let r = intersect_triangle(
-                    vertices[3u * i].position,
-                    vertices[3u * i + 1u].position,
-                    vertices[3u * i + 2u].position,
-                    ray,
-                    (*hit).t,
-                );
-                if r.x < (*hit).t {
-                    *hit = Hit(r.x, object, i, r.y, r.z);
-                }
-            }
-        } else {
-            let a = node.first_index;
-            let ta = intersect_aabb(nodes[a], ray.origin, inv_dir, (*hit).t);
-            let tb = intersect_aabb(nodes[a + 1u], ray.origin, inv_dir, (*hit).t);
-            if ta != MISS && tb != MISS {
-                let near_is_a = ta <= tb;
-                index = select(a, a + 1u, !near_is_a);
-                if sp < STACK_SIZE {
-                    stack_node[sp] = select(a + 1u, a, !near_is_a);
-                    stack_t[sp] = max(ta, tb);
-                    sp++;
-                }
-                descend = true;
-            } else if ta != MISS || tb != MISS {
-                index = select(a + 1u, a, ta != MISS);
-                descend = true;
-            }
-        }
-        if !descend {
-            // Pop the next subtree still nearer than the current hit.
-            var found = false;
-            while sp > 0u {
-                sp--;
-                if stack_t[sp] < (*hit).t {
-                    index = stack_node[sp];
-                    found = true;
-                    break;
-                }
-            }
-            if !found {
-                break;
-            }
-        }
-    }
-}
-
-// Nearest hit among a mesh's triangles without its BLAS (the slower `ACCEL` schemes).
-fn intersect_triangles(object: u32, o: Object, ray: Ray, inv_dir: vec3f, hit: ptr<function, Hit>) {
-    if ACCEL == ACCEL_BOUNDING_VOLUME && intersect_aabb(nodes[o.blas_root], ray.origin, inv_dir, (*hit).t) == MISS {
-        return;
-    }
-    for (var i = o.first_triangle; i < o.first_triangle + o.triangle_count; i++) {
-        let r = intersect_triangle(
-            vertices[3u * i].position,
-            vertices[3u * i + 1u].position,
-            vertices[3u * i + 2u].position,
-            ray,
-            (*hit).t,
-        );
-        if r.x < (*hit).t {
-            *hit = Hit(r.x, object, i, r.y, r.z);
-        }
-    }
-}
-
-// Nearest hit on object `i` (in top-level order), updating `hit`.
-fn intersect_object(i: u32, ray: Ray, inv_dir: vec3f, hit: ptr<function, Hit>) {
-    let o = objects[i];
+// Nearest hit on quad, sphere or cylinder `i` (top-level order), updating `hit`.
+fn intersect_shape(i: u32, o: Object, ray: Ray, hit: ptr<function, Hit>) {
     switch o.kind {
         case KIND_QUAD: {
             let r = intersect_quad(o.a.xyz, o.b.xyz, o.c.xyz, ray, (*hit).t);
@@ -123,48 +48,91 @@ fn intersect_object(i: u32, ray: Ray, inv_dir: vec3f, hit: ptr<function, Hit>) {
                 *hit = Hit(t, i, 0u, 0.0, 0.0);
             }
         }
-        case KIND_CYLINDER: {
+        default: {
             let t = intersect_cylinder(o.a.xyz, o.b.xyz, o.a.w, (o.flags & FLAG_CAPS) != 0u, ray, (*hit).t);
             if t < (*hit).t {
                 *hit = Hit(t, i, 0u, 0.0, 0.0);
             }
         }
-        default: {
-            if ACCEL == ACCEL_BVH {
-                intersect_mesh(i, o.blas_root, ray, inv_dir, hit);
-            } else {
-                intersect_triangles(i, o, ray, inv_dir, hit);
-            }
+    }
+}
+
+// Nearest hit among triangles `first .. first + count` of mesh object `object`.
+fn intersect_triangles(object: u32, first: u32, count: u32, ray: Ray, hit: ptr<function, Hit>) {
+    for (var i = first; i < first + count; i++) {
+        let r = intersect_triangle(
+            vertices[3u * i].position,
+            vertices[3u * i + 1u].position,
+            vertices[3u * i + 2u].position,
+            ray,
+            (*hit).t,
+        );
+        if r.x < (*hit).t {
+            *hit = Hit(r.x, object, i, r.y, r.z);
         }
     }
 }
 
-// Nearest hit in (0, t_max) over the whole scene; `object_count` 0 means an empty scene.
-fn intersect_scene(ray: Ray, t_max: f32, object_count: u32) -> Hit {
+// The slower `ACCEL` schemes: every object in turn.
+fn intersect_linear(ray: Ray, inv_dir: vec3f, object_count: u32, any_hit: bool, hit: ptr<function, Hit>) {
+    for (var i = 0u; i < object_count; i++) {
+        let o = objects[i];
+        if o.kind != KIND_MESH {
+            intersect_shape(i, o, ray, hit);
+        } else if ACCEL == ACCEL_BRUTE_FORCE
+            || intersect_aabb(nodes[o.blas_root], ray.origin, inv_dir, (*hit).t) != MISS {
+            intersect_triangles(i, o.first_triangle, o.triangle_count, ray, hit);
+        }
+        if any_hit && (*hit).object != NO_HIT {
+            return;
+        }
+    }
+}
+
+// Nearest hit in (0, t_max) over the whole scene, or with `any_hit` the first one found;
+// `object_count` 0 means an empty scene.
+fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
     var hit = Hit(t_max, NO_HIT, 0u, 0.0, 0.0);
     if object_count == 0u {
         return hit;
     }
     let inv_dir = safe_inverse(ray.dir);
     if ACCEL != ACCEL_BVH {
-        for (var i = 0u; i < object_count; i++) {
-            intersect_object(i, ray, inv_dir, &hit);
-        }
+        intersect_linear(ray, inv_dir, object_count, any_hit, &hit);
+        return hit;
+    }
+    if intersect_aabb(nodes[0], ray.origin, inv_dir, hit.t) == MISS {
         return hit;
     }
     var stack_node: array<u32, STACK_SIZE>;
     var stack_t: array<f32, STACK_SIZE>;
     var sp = 0u;
     var index = 0u;
-    if intersect_aabb(nodes[0], ray.origin, inv_dir, hit.t) == MISS {
-        return hit;
-    }
+    // The mesh whose BLAS is being walked, or NO_HIT in the top level.
+    var mesh = NO_HIT;
     loop {
         let node = nodes[index];
         var descend = false;
         if node.prim_count > 0u {
-            for (var i = node.first_index; i < node.first_index + node.prim_count; i++) {
-                intersect_object(i, ray, inv_dir, &hit);
+            if mesh != NO_HIT {
+                intersect_triangles(mesh, node.first_index, node.prim_count, ray, &hit);
+            } else {
+                for (var i = node.first_index; i < node.first_index + node.prim_count; i++) {
+                    let o = objects[i];
+                    if o.kind != KIND_MESH {
+                        intersect_shape(i, o, ray, &hit);
+                    } else if sp < STACK_SIZE {
+                        let t = intersect_aabb(nodes[o.blas_root], ray.origin, inv_dir, hit.t);
+                        if t != MISS {
+                            stack_node[sp] = ENTER_MESH | i;
+                            stack_t[sp] = t;
+                            sp++;
+                        }
+                    }
+                }
+            }
+            if any_hit && hit.object != NO_HIT {
+                break;
             }
         } else {
             let a = node.first_index;
@@ -185,11 +153,23 @@ fn intersect_scene(ray: Ray, t_max: f32, object_count: u32) -> Hit {
             }
         }
         if !descend {
+            // Pop the next entry still nearer than the current hit.
             var found = false;
             while sp > 0u {
                 sp--;
-                if stack_t[sp] < hit.t {
-                    index = stack_node[sp];
+                let entry = stack_node[sp];
+                if entry == LEAVE_MESH {
+                    mesh = NO_HIT;
+                } else if stack_t[sp] < hit.t {
+                    if (entry & ENTER_MESH) != 0u {
+                        mesh = entry & ~ENTER_MESH;
+                        index = objects[mesh].blas_root;
+                        // The slot just freed holds the marker below the BLAS entries.
+                        stack_node[sp] = LEAVE_MESH;
+                        sp++;
+                    } else {
+                        index = entry;
+                    }
                     found = true;
                     break;
                 }
@@ -200,4 +180,14 @@ fn intersect_scene(ray: Ray, t_max: f32, object_count: u32) -> Hit {
         }
     }
     return hit;
+}
+
+// Nearest hit in (0, t_max) over the whole scene.
+fn intersect_scene(ray: Ray, t_max: f32, object_count: u32) -> Hit {
+    return trace_scene(ray, t_max, object_count, false);
+}
+
+// Whether anything lies on the ray in (0, t_max).
+fn any_hit_scene(ray: Ray, t_max: f32, object_count: u32) -> bool {
+    return trace_scene(ray, t_max, object_count, true).object != NO_HIT;
 }

@@ -95,12 +95,11 @@ fn occluded(p: vec3f, ng: vec3f, ls: LightSample) -> bool {
     let origin = offset_origin(p, ng, ls.wi);
     rays_traced++;
     if !ls.finite {
-        return intersect_scene(Ray(origin, ls.wi), T_MAX, params.object_count).object != NO_HIT;
+        return any_hit_scene(Ray(origin, ls.wi), T_MAX, params.object_count);
     }
     let to_light = ls.point - origin;
     let distance = length(to_light);
-    let hit = intersect_scene(Ray(origin, to_light / distance), distance * (1.0 - 1e-4), params.object_count);
-    return hit.object != NO_HIT;
+    return any_hit_scene(Ray(origin, to_light / distance), distance * (1.0 - 1e-4), params.object_count);
 }
 
 fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {

@@ -4,17 +4,21 @@
 //! software adapters (lavapipe on Vulkan, llvmpipe on GL); within a kind, Vulkan, Metal and
 //! DX12 before GL. `WGPU_BACKEND` restricts the backends, a name restricts the adapters.
 
+use std::sync::Arc;
+
 use wgpu::{Adapter, AdapterInfo, Backend, DeviceType};
 
 use crate::error::RenderError;
 
-/// An open device with its queue and the adapter it runs on.
-#[derive(Debug)]
+/// An open device with its queue and the adapter it runs on (clones share the device).
+#[derive(Debug, Clone)]
 pub struct GpuContext {
     /// The device.
     pub device: wgpu::Device,
     /// Its queue.
     pub queue: wgpu::Queue,
+    /// The adapter.
+    pub adapter: Adapter,
     /// The adapter's description.
     pub adapter_info: AdapterInfo,
 }
@@ -64,39 +68,92 @@ fn adapters_on(backends: wgpu::Backends) -> Vec<Adapter> {
     pollster::block_on(instance.enumerate_adapters(backends))
 }
 
+/// The best-ranked adapter of `adapters` whose name contains `name` (any case), or whose
+/// backend is called `name`.
+fn choose(adapters: Vec<Adapter>, name: Option<&str>) -> Result<Adapter, RenderError> {
+    let names: Vec<String> = adapters.iter().map(|a| describe(&a.get_info())).collect();
+    let wanted = name.map(str::to_lowercase);
+    adapters
+        .into_iter()
+        .filter(|a| {
+            let info = a.get_info();
+            wanted.as_ref().is_none_or(|w| {
+                info.name.to_lowercase().contains(w)
+                    || format!("{:?}", info.backend).to_lowercase() == *w
+            })
+        })
+        .min_by_key(|a| rank(&a.get_info()))
+        .ok_or_else(|| match name {
+            Some(name) => RenderError::NoAdapter(format!(
+                "no adapter matches {name:?}; found: {}",
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join("; ")
+                }
+            )),
+            None => RenderError::NoAdapter(
+                "no GPU adapter found. Install a Vulkan driver; without a GPU, Mesa's \
+                 software one works: `apt-get install mesa-vulkan-drivers` (lavapipe), or \
+                 a GL driver (`libgl1-mesa-dri`, llvmpipe)"
+                    .into(),
+            ),
+        })
+}
+
 impl GpuContext {
     /// Opens the preferred adapter, or the best one whose name contains `name` (any case).
     pub fn new(name: Option<&str>) -> Result<Self, RenderError> {
-        let adapters = available_adapters();
-        let names: Vec<String> = adapters.iter().map(|a| describe(&a.get_info())).collect();
-        let wanted = name.map(str::to_lowercase);
-        let adapter = adapters
-            .into_iter()
-            .filter(|a| {
-                let info = a.get_info();
-                wanted.as_ref().is_none_or(|w| {
-                    info.name.to_lowercase().contains(w)
-                        || format!("{:?}", info.backend).to_lowercase() == *w
-                })
-            })
-            .min_by_key(|a| rank(&a.get_info()))
-            .ok_or_else(|| match name {
-                Some(name) => RenderError::NoAdapter(format!(
-                    "no adapter matches {name:?}; found: {}",
-                    if names.is_empty() {
-                        "none".to_string()
-                    } else {
-                        names.join("; ")
-                    }
-                )),
-                None => RenderError::NoAdapter(
-                    "no GPU adapter found. Install a Vulkan driver; without a GPU, Mesa's \
-                     software one works: `apt-get install mesa-vulkan-drivers` (lavapipe), or \
-                     a GL driver (`libgl1-mesa-dri`, llvmpipe)"
-                        .into(),
-                ),
-            })?;
-        Self::from_adapter(&adapter)
+        Self::from_adapter(&choose(available_adapters(), name)?)
+    }
+
+    /// Opens the preferred adapter (or the best matching `name`) among those that can
+    /// present to `window`, with a surface on the window. Backends are searched as by
+    /// [`available_adapters`].
+    pub fn for_window<W>(
+        name: Option<&str>,
+        window: Arc<W>,
+    ) -> Result<(Self, wgpu::Surface<'static>), RenderError>
+    where
+        W: wgpu::WindowHandle + wgpu::rwh::HasDisplayHandle + std::fmt::Debug + 'static,
+    {
+        let searches = match wgpu::Backends::from_env() {
+            Some(backends) => vec![backends],
+            None => vec![wgpu::Backends::PRIMARY, wgpu::Backends::GL],
+        };
+        let mut last_error = None;
+        for backends in searches {
+            let mut descriptor = wgpu::InstanceDescriptor::new_with_display_handle_from_env(
+                Box::new(window.clone()),
+            );
+            descriptor.backends = backends;
+            let instance = wgpu::Instance::new(descriptor);
+            let surface = match instance.create_surface(window.clone()) {
+                Ok(surface) => surface,
+                Err(err) => {
+                    last_error = Some(RenderError::NoAdapter(format!(
+                        "cannot create a surface on the window ({backends:?}): {err}"
+                    )));
+                    continue;
+                }
+            };
+            let adapters: Vec<Adapter> = pollster::block_on(instance.enumerate_adapters(backends))
+                .into_iter()
+                .filter(|a| a.is_surface_supported(&surface))
+                .collect();
+            if adapters.is_empty() {
+                continue;
+            }
+            let ctx = Self::from_adapter(&choose(adapters, name)?)?;
+            return Ok((ctx, surface));
+        }
+        Err(last_error.unwrap_or_else(|| {
+            RenderError::NoAdapter(
+                "no adapter can present to the window. Install a Vulkan driver (without a GPU: \
+                 `apt-get install mesa-vulkan-drivers`), or render headless with `pathlight render`"
+                    .into(),
+            )
+        }))
     }
 
     /// Opens a device on `adapter` with the adapter's own limits (more storage buffers and
@@ -118,6 +175,7 @@ impl GpuContext {
         Ok(Self {
             device,
             queue,
+            adapter: adapter.clone(),
             adapter_info,
         })
     }

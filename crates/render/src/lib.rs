@@ -1,6 +1,7 @@
 //! pathlight's GPU side: adapter choice, the WGSL integrator and the progressive film.
 
 pub mod context;
+pub mod display;
 pub mod error;
 pub mod renderer;
 pub mod scene_buffers;

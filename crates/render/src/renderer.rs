@@ -52,16 +52,20 @@ impl Accel {
 
 /// A scene on the device with its accumulation buffer.
 #[derive(Debug)]
-pub struct ProgressiveRenderer<'a> {
-    ctx: &'a GpuContext,
+pub struct ProgressiveRenderer {
+    /// The device (a cheap clone of the caller's context).
+    ctx: GpuContext,
     scene: SceneBuffers,
     pipeline: wgpu::ComputePipeline,
     params_buffer: wgpu::Buffer,
     accum_buffer: wgpu::Buffer,
     /// Rays traced since the last restart (64-bit: low word, high word).
     ray_counter: wgpu::Buffer,
+    frame_layout: wgpu::BindGroupLayout,
     frame_bind_group: wgpu::BindGroup,
     params: GpuFrameParams,
+    /// Rows of the frame in progress ([`Self::step_frame`]) that already hold its sample.
+    rows_ahead: u32,
     /// Samples per pixel accumulated so far.
     samples_done: u32,
     /// Current piece size: rows per dispatch and samples per pixel per dispatch.
@@ -71,37 +75,22 @@ pub struct ProgressiveRenderer<'a> {
     adaptive: bool,
 }
 
-impl<'a> ProgressiveRenderer<'a> {
+impl ProgressiveRenderer {
     /// Uploads the scene and creates the pipeline; the image starts empty.
-    pub fn new(
-        ctx: &'a GpuContext,
-        scene: &Scene,
-        gpu_scene: &GpuScene,
-    ) -> Result<Self, RenderError> {
+    pub fn new(ctx: &GpuContext, scene: &Scene, gpu_scene: &GpuScene) -> Result<Self, RenderError> {
         Self::with_accel(ctx, scene, gpu_scene, Accel::Bvh)
     }
 
     /// [`Self::new`] with the given acceleration scheme.
     pub fn with_accel(
-        ctx: &'a GpuContext,
+        ctx: &GpuContext,
         scene: &Scene,
         gpu_scene: &GpuScene,
         accel: Accel,
     ) -> Result<Self, RenderError> {
         let device = &ctx.device;
         let params = frame_params(scene, gpu_scene);
-        let pixels = u64::from(params.width) * u64::from(params.height);
-        let accum_size = pixels * size_of::<GpuAccumPixel>() as u64;
-        let limit = device.limits().max_storage_buffer_binding_size;
-        if accum_size > limit {
-            return Err(RenderError::Limits(format!(
-                "a {}x{} image needs a {} MiB accumulation buffer; this device binds at most {} MiB",
-                params.width,
-                params.height,
-                accum_size >> 20,
-                limit >> 20
-            )));
-        }
+        let accum_size = accumulation_size(device, &params)?;
         let scene_buffers = SceneBuffers::upload(device, gpu_scene)?;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame layout"),
@@ -134,14 +123,7 @@ impl<'a> ProgressiveRenderer<'a> {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let accum_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("accumulation"),
-            size: accum_size,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let accum_buffer = create_accumulation(device, accum_size);
         let ray_counter = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("ray counter"),
             size: size_of::<u64>() as u64,
@@ -150,32 +132,23 @@ impl<'a> ProgressiveRenderer<'a> {
                 | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let frame_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("frame"),
-            layout: &frame_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: accum_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: ray_counter.as_entire_binding(),
-                },
-            ],
-        });
+        let frame_bind_group = frame_bind_group(
+            device,
+            &frame_layout,
+            &params_buffer,
+            &accum_buffer,
+            &ray_counter,
+        );
         Ok(Self {
-            ctx,
+            ctx: ctx.clone(),
             scene: scene_buffers,
             pipeline,
             params_buffer,
             accum_buffer,
             ray_counter,
+            frame_layout,
             frame_bind_group,
+            rows_ahead: 0,
             rows_per_dispatch: params.height.min(WORKGROUP * 4),
             batch_samples: 1,
             adaptive: true,
@@ -272,6 +245,75 @@ impl<'a> ProgressiveRenderer<'a> {
         self.ctx.queue.submit([encoder.finish()]);
     }
 
+    /// Replaces the scene (geometry, materials, lights, camera, image size) keeping the
+    /// compiled pipeline, and restarts. Used by the viewer after a camera move, a resize or a
+    /// light toggle.
+    pub fn set_scene(&mut self, scene: &Scene, gpu_scene: &GpuScene) -> Result<(), RenderError> {
+        let device = &self.ctx.device;
+        let params = frame_params(scene, gpu_scene);
+        if (params.width, params.height) != (self.params.width, self.params.height) {
+            self.accum_buffer = create_accumulation(device, accumulation_size(device, &params)?);
+            self.frame_bind_group = frame_bind_group(
+                device,
+                &self.frame_layout,
+                &self.params_buffer,
+                &self.accum_buffer,
+                &self.ray_counter,
+            );
+            self.rows_per_dispatch = params.height.min(WORKGROUP * 4);
+            self.batch_samples = 1;
+        }
+        self.scene = SceneBuffers::upload(device, gpu_scene)?;
+        self.params = params;
+        self.restart();
+        Ok(())
+    }
+
+    /// Renders the next band of rows of the current frame (one sample per pixel), sized so
+    /// that a submission takes about `target`; returns whether the frame is complete. Rows
+    /// `0 .. rows_ahead()` of an incomplete frame hold one sample more than the others.
+    pub fn step_frame(&mut self, target: Duration) -> Result<bool, RenderError> {
+        let height = self.params.height;
+        let rows = self.rows_per_dispatch.min(height - self.rows_ahead);
+        let started = Instant::now();
+        self.submit(self.rows_ahead, rows, 1);
+        self.wait()?;
+        let elapsed = started.elapsed();
+        self.rows_ahead += rows;
+        // Next band: scale by the measured time, in whole workgroups of rows.
+        let scale = target.as_secs_f64() / elapsed.as_secs_f64().max(1e-6);
+        let next = (f64::from(rows) * scale.clamp(0.5, 2.0)) as u32;
+        self.rows_per_dispatch =
+            (next / WORKGROUP * WORKGROUP).clamp(WORKGROUP.min(height), height);
+        if self.rows_ahead < height {
+            return Ok(false);
+        }
+        self.rows_ahead = 0;
+        self.samples_done += 1;
+        Ok(true)
+    }
+
+    /// Rows of the frame in progress that already hold its sample (see [`Self::step_frame`]).
+    pub fn rows_ahead(&self) -> u32 {
+        self.rows_ahead
+    }
+
+    /// The accumulation buffer (per pixel [`GpuAccumPixel`]: a fixed-point sum of samples),
+    /// for a display pass to read.
+    pub fn accumulation(&self) -> &wgpu::Buffer {
+        &self.accum_buffer
+    }
+
+    /// The device it renders on.
+    pub fn context(&self) -> &GpuContext {
+        &self.ctx
+    }
+
+    /// Image width and height in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.params.width, self.params.height)
+    }
+
     /// Empties the image and the ray count (the next sample is sample 0 again).
     pub fn restart(&mut self) {
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
@@ -279,6 +321,7 @@ impl<'a> ProgressiveRenderer<'a> {
         encoder.clear_buffer(&self.ray_counter, 0, None);
         self.ctx.queue.submit([encoder.finish()]);
         self.samples_done = 0;
+        self.rows_ahead = 0;
     }
 
     /// Rays traced (camera, extension and shadow rays) since the start or the last restart.
@@ -336,13 +379,18 @@ impl<'a> ProgressiveRenderer<'a> {
         Ok(bytemuck::cast_slice(&view).to_vec())
     }
 
-    /// Copies the accumulation back and divides by the sample count.
+    /// Copies the accumulation back and divides by each pixel's sample count. `spp` of the
+    /// film counts whole frames only.
     pub fn read_film(&self) -> Result<Film, RenderError> {
         let accum: Vec<GpuAccumPixel> = self.read_buffer(&self.accum_buffer)?;
-        let scale = 1.0 / f64::from(self.samples_done.max(1));
+        let width = self.params.width as usize;
         let pixels = accum
             .iter()
-            .map(|a| {
+            .enumerate()
+            .map(|(i, a)| {
+                // Rows ahead in a frame in progress hold one sample more.
+                let ahead = (i / width) < self.rows_ahead as usize;
+                let scale = 1.0 / f64::from((self.samples_done + u32::from(ahead)).max(1));
                 [0, 1, 2].map(|c| {
                     let v = (a.channel_sum(c) * scale) as f32;
                     if v.is_finite() { v } else { 0.0 }
@@ -356,4 +404,56 @@ impl<'a> ProgressiveRenderer<'a> {
             pixels,
         })
     }
+}
+
+/// Bytes of the accumulation buffer for `params`' image, or why the device cannot bind it.
+fn accumulation_size(device: &wgpu::Device, params: &GpuFrameParams) -> Result<u64, RenderError> {
+    let pixels = u64::from(params.width) * u64::from(params.height);
+    let size = pixels * size_of::<GpuAccumPixel>() as u64;
+    let limit = device.limits().max_storage_buffer_binding_size;
+    if size > limit {
+        return Err(RenderError::Limits(format!(
+            "a {}x{} image needs a {} MiB accumulation buffer; this device binds at most {} MiB",
+            params.width,
+            params.height,
+            size >> 20,
+            limit >> 20
+        )));
+    }
+    Ok(size)
+}
+
+/// An empty accumulation buffer of `size` bytes.
+fn create_accumulation(device: &wgpu::Device, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("accumulation"),
+        size,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// Bind group 1 of the integrator: parameters, accumulation, ray counter.
+fn frame_bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    params: &wgpu::Buffer,
+    accum: &wgpu::Buffer,
+    ray_counter: &wgpu::Buffer,
+) -> wgpu::BindGroup {
+    let entries: Vec<_> = [params, accum, ray_counter]
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("frame"),
+        layout,
+        entries: &entries,
+    })
 }

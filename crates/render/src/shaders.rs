@@ -19,8 +19,10 @@ pub const BSDF: &str = include_str!("../shaders/bsdf.wgsl");
 pub const LIGHTS: &str = include_str!("../shaders/lights.wgsl");
 /// The path-tracing pass (entry point `render`).
 pub const INTEGRATOR: &str = include_str!("../shaders/integrator.wgsl");
+/// The viewer's display pass (a module of its own).
+pub const DISPLAY: &str = include_str!("../shaders/display.wgsl");
 
-/// Every shader file with its name, for validation.
+/// Every shader file of the integrator module with its name, for validation.
 pub const FILES: [(&str, &str); 9] = [
     ("scene.wgsl", SCENE),
     ("intersect.wgsl", INTERSECT),

@@ -9,6 +9,7 @@ use pathlight_core::gpu::{
     GpuAccumPixel, GpuBvhNode, GpuFrameParams, GpuLight, GpuMaterial, GpuObject, GpuTextureInfo,
     GpuVertex,
 };
+use pathlight_render::display::GpuDisplayParams;
 use pathlight_render::shaders;
 
 fn parse_and_validate(label: &str, source: &str) -> naga::Module {
@@ -31,13 +32,14 @@ fn every_wgsl_file_validates_within_its_modules() {
             "{name} is not part of the integrator module"
         );
     }
+    parse_and_validate("display module", shaders::DISPLAY);
     let on_disk = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders"))
         .unwrap()
         .count();
     assert_eq!(
         on_disk,
-        shaders::FILES.len(),
-        "a file under shaders/ is not listed in shaders::FILES"
+        shaders::FILES.len() + 1,
+        "a file under shaders/ is neither in shaders::FILES nor the display module"
     );
 }
 
@@ -150,6 +152,25 @@ fn host_structs_match_their_wgsl_declarations() {
         ]
     );
     assert_layout!(m, "AccumPixel", GpuAccumPixel, [hi, lo]);
+
+    let display = parse_and_validate("display module", shaders::DISPLAY);
+    let d = &display;
+    assert_layout!(d, "DisplayPixel", GpuAccumPixel, [hi, lo]);
+    assert_layout!(
+        d,
+        "DisplayParams",
+        GpuDisplayParams,
+        [
+            width,
+            height,
+            samples,
+            rows_ahead,
+            target_width,
+            target_height,
+            tonemap,
+            encode_srgb
+        ]
+    );
 }
 
 #[test]

@@ -17,7 +17,7 @@ use wgpu::util::DeviceExt;
 /// A test-only pass: one ray per invocation, nearest hit written back.
 const KERNEL: &str = r#"
 struct TraceRay { origin: vec3f, t_max: f32, dir: vec3f, pad: f32 }
-struct TraceHit { t: f32, object: u32, primitive: u32, pad: u32 }
+struct TraceHit { t: f32, object: u32, primitive: u32, blocked: u32 }
 @group(1) @binding(0) var<storage, read> rays: array<TraceRay>;
 @group(1) @binding(1) var<storage, read_write> hits: array<TraceHit>;
 
@@ -29,7 +29,8 @@ fn trace(@builtin(global_invocation_id) gid: vec3u) {
     }
     let r = rays[i];
     let hit = intersect_scene(Ray(r.origin, r.dir), r.t_max, OBJECT_COUNT);
-    hits[i] = TraceHit(hit.t, hit.object, hit.primitive, 0u);
+    let blocked = any_hit_scene(Ray(r.origin, r.dir), r.t_max, OBJECT_COUNT);
+    hits[i] = TraceHit(hit.t, hit.object, hit.primitive, select(0u, 1u, blocked));
 }
 "#;
 
@@ -48,7 +49,8 @@ struct TraceHit {
     t: f32,
     object: u32,
     primitive: u32,
-    pad: u32,
+    /// The shadow-ray query's answer (1: something lies before t_max).
+    blocked: u32,
 }
 
 fn trace_on_gpu(gpu_scene: &GpuScene, rays: &[TraceRay], accel: Accel) -> Vec<TraceHit> {
@@ -177,6 +179,11 @@ fn check_hits(gpu_scene: &GpuScene, rays: &[TraceRay], hits: &[TraceHit], accel:
                 dir: ray.dir.into(),
             },
             ray.t_max,
+        );
+        assert_eq!(
+            gpu.blocked == 1,
+            cpu.is_some(),
+            "{accel:?}: any-hit query disagrees with the nearest hit {cpu:?}"
         );
         match cpu {
             None => assert_eq!(

@@ -1,0 +1,304 @@
+//! `pathlight view` end to end under a real X server: Xvfb, with xdotool for the mouse and
+//! keys and ImageMagick's `import` for screenshots (Debian packages `xvfb`, `xdotool`,
+//! `imagemagick`; `.ci/run` installs them). The viewer renders on whatever adapter presents
+//! to the window (lavapipe on CI).
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Longest wait for a line; the first frame on a software adapter includes compiling the
+/// integrator (about 10 s on lavapipe in a debug build).
+const LINE_TIMEOUT: Duration = Duration::from_secs(240);
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn require(tool: &str) {
+    let found = Command::new("sh")
+        .args(["-c", &format!("command -v {tool}")])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    assert!(
+        found,
+        "{tool} is missing: install the Debian packages xvfb xdotool imagemagick (.ci/run does)"
+    );
+}
+
+/// An Xvfb server on a free display number, stopped on drop.
+struct XServer {
+    display: String,
+    process: Child,
+}
+
+impl XServer {
+    fn start() -> Self {
+        require("Xvfb");
+        let number = (90..200)
+            .find(|n| {
+                !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
+                    && !Path::new(&format!("/tmp/.X{n}-lock")).exists()
+            })
+            .expect("a free X display number");
+        let display = format!(":{number}");
+        let process = Command::new("Xvfb")
+            .args([&display, "-screen", "0", "320x240x24", "-nolisten", "tcp"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("Xvfb starts");
+        let socket = format!("/tmp/.X11-unix/X{number}");
+        let started = Instant::now();
+        while !Path::new(&socket).exists() {
+            assert!(
+                started.elapsed() < Duration::from_secs(20),
+                "Xvfb did not come up"
+            );
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        Self { display, process }
+    }
+
+    /// Runs an X client (xdotool, import) on this display; returns its stdout.
+    fn run(&self, program: &str, args: &[&str]) -> String {
+        require(program);
+        let output = Command::new(program)
+            .args(args)
+            .env("DISPLAY", &self.display)
+            .output()
+            .unwrap_or_else(|err| panic!("{program} runs: {err}"));
+        assert!(
+            output.status.success(),
+            "{program} {args:?}: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        String::from_utf8_lossy(&output.stdout).into_owned()
+    }
+}
+
+impl Drop for XServer {
+    fn drop(&mut self) {
+        let _ = self.process.kill();
+        let _ = self.process.wait();
+    }
+}
+
+/// The viewer process with its standard output collected line by line.
+struct Viewer {
+    process: Child,
+    lines: Arc<Mutex<Vec<String>>>,
+    stderr: Arc<Mutex<String>>,
+}
+
+impl Viewer {
+    fn start(x: &XServer, scene: &Path, save_dir: &Path) -> Self {
+        let mut process = Command::new(env!("CARGO_BIN_EXE_pathlight"))
+            .arg("view")
+            .arg(scene)
+            .args(["--width", "64", "--height", "64", "--frames-per-iter", "3"])
+            .args(["--iters", "2", "--save-dir"])
+            .arg(save_dir)
+            .env("DISPLAY", &x.display)
+            .env_remove("WAYLAND_DISPLAY")
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the viewer starts");
+        let lines = Arc::new(Mutex::new(Vec::new()));
+        let sink = lines.clone();
+        let stdout = process.stdout.take().unwrap();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+                sink.lock().unwrap().push(line);
+            }
+        });
+        let stderr = Arc::new(Mutex::new(String::new()));
+        let sink = stderr.clone();
+        let pipe = process.stderr.take().unwrap();
+        std::thread::spawn(move || {
+            for line in BufReader::new(pipe).lines().map_while(Result::ok) {
+                sink.lock().unwrap().push_str(&(line + "\n"));
+            }
+        });
+        Self {
+            process,
+            lines,
+            stderr,
+        }
+    }
+
+    fn output(&self) -> String {
+        format!(
+            "stdout:\n{}\nstderr:\n{}",
+            self.lines.lock().unwrap().join("\n"),
+            self.stderr.lock().unwrap()
+        )
+    }
+
+    /// Waits for the `n`-th line (from 1) starting with `prefix`; returns it.
+    fn wait_for(&mut self, prefix: &str, n: usize) -> String {
+        let started = Instant::now();
+        loop {
+            let found = self
+                .lines
+                .lock()
+                .unwrap()
+                .iter()
+                .filter(|l| l.starts_with(prefix))
+                .nth(n - 1)
+                .cloned();
+            if let Some(line) = found {
+                return line;
+            }
+            if let Ok(Some(status)) = self.process.try_wait() {
+                panic!(
+                    "the viewer exited ({status}) before {prefix:?}\n{}",
+                    self.output()
+                );
+            }
+            assert!(
+                started.elapsed() < LINE_TIMEOUT,
+                "no {prefix:?} after {LINE_TIMEOUT:?}\n{}",
+                self.output()
+            );
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+
+    fn count(&self, prefix: &str) -> usize {
+        let lines = self.lines.lock().unwrap();
+        lines.iter().filter(|l| l.starts_with(prefix)).count()
+    }
+}
+
+impl Drop for Viewer {
+    fn drop(&mut self) {
+        let _ = self.process.kill();
+        let _ = self.process.wait();
+    }
+}
+
+/// Mean 8-bit RGB over the 5x5 pixels around (x, y) of a PNG.
+fn patch_mean(png: &Path, x: u32, y: u32) -> f64 {
+    let image = image::open(png)
+        .unwrap_or_else(|err| panic!("{}: {err}", png.display()))
+        .to_rgb8();
+    let mut sum = 0.0;
+    for py in y - 2..=y + 2 {
+        for px in x - 2..=x + 2 {
+            sum += image
+                .get_pixel(px, py)
+                .0
+                .iter()
+                .map(|&c| f64::from(c))
+                .sum::<f64>()
+                / 3.0;
+        }
+    }
+    sum / 25.0
+}
+
+/// A screenshot of window `id` as a PNG in `dir`.
+fn screenshot(x: &XServer, id: &str, dir: &Path, name: &str) -> PathBuf {
+    let path = dir.join(name);
+    x.run("import", &["-window", id, path.to_str().unwrap()]);
+    path
+}
+
+/// The Cornell box of the references with a diffuse ball named "ball" in the middle; at
+/// 64x64 the ball's centre is at pixel (32, 42).
+fn ball_scene(dir: &Path) -> PathBuf {
+    let room = std::fs::read_to_string(repo().join("scenes/refs/cornell-diffuse.toml")).unwrap();
+    let scene = format!(
+        "{room}\n[[sphere]]\nname = \"ball\"\nmaterial = \"white\"\ncenter = [0, -0.4, 0]\nradius = 0.5\n"
+    );
+    let path = dir.join("ball.toml");
+    std::fs::write(&path, scene).unwrap();
+    path
+}
+
+#[test]
+fn viewer_iterates_waits_for_right_clicks_picks_and_saves() {
+    let x = XServer::start();
+    let dir = tempfile::tempdir().unwrap();
+    let mut viewer = Viewer::start(&x, &ball_scene(dir.path()), dir.path());
+
+    // Iteration 1 runs at once and reports its frame rate.
+    let line = viewer.wait_for("iter 1 finished", 1);
+    assert!(line.ends_with("fps"), "{line}");
+    let fps: f64 = line.split_whitespace().nth(3).unwrap().parse().unwrap();
+    assert!(fps > 0.0, "{line}");
+
+    // No second iteration until a right click.
+    std::thread::sleep(Duration::from_secs(3));
+    assert_eq!(viewer.count("iter 2"), 0, "{}", viewer.output());
+    let window = x
+        .run("xdotool", &["search", "--sync", "--name", "^pathlight"])
+        .lines()
+        .next()
+        .expect("the viewer's window")
+        .to_string();
+    let title = x.run("xdotool", &["getwindowname", &window]);
+    assert!(
+        title.contains("iter 1/2") && title.contains("right-click"),
+        "{title}"
+    );
+    x.run(
+        "xdotool",
+        &["mousemove", "--window", &window, "10", "10", "click", "3"],
+    );
+    viewer.wait_for("iter 2 finished", 1);
+    assert!(viewer.output().contains("all 2 iterations finished"));
+
+    // `S` saves PNG and EXR.
+    x.run("xdotool", &["windowfocus", "--sync", &window]);
+    x.run("xdotool", &["key", "s"]);
+    let saved = viewer.wait_for("saved", 1);
+    let before_png = dir.path().join("pathlight-view-001.png");
+    assert!(
+        before_png.exists() && dir.path().join("pathlight-view-001.exr").exists(),
+        "{saved}"
+    );
+    let before_screen = screenshot(&x, &window, dir.path(), "before.png");
+
+    // A left click on the ball turns it into a light and restarts the image.
+    x.run(
+        "xdotool",
+        &["mousemove", "--window", &window, "32", "42", "click", "1"],
+    );
+    assert_eq!(viewer.wait_for("picked", 1), "picked ball: light on");
+    viewer.wait_for("iter 1 finished", 2);
+    x.run("xdotool", &["key", "s"]);
+    viewer.wait_for("saved", 2);
+    let after_png = dir.path().join("pathlight-view-002.png");
+    let after_screen = screenshot(&x, &window, dir.path(), "after.png");
+    for (before, after) in [(&before_png, &after_png), (&before_screen, &after_screen)] {
+        let (b, a) = (patch_mean(before, 32, 42), patch_mean(after, 32, 42));
+        // Diffuse grey before; an emitter of 0.73 x 17 clamps to white after.
+        assert!(
+            b < 200.0 && a > 245.0,
+            "{}: ball {b:.0} -> {a:.0}",
+            after.display()
+        );
+        // The rest of the room brightens but stays a room: a wall corner is not white.
+        assert!(patch_mean(after, 4, 4) < 250.0);
+    }
+
+    // `Esc` quits cleanly.
+    x.run("xdotool", &["key", "Escape"]);
+    let started = Instant::now();
+    let status = loop {
+        if let Some(status) = viewer.process.try_wait().unwrap() {
+            break status;
+        }
+        assert!(
+            started.elapsed() < Duration::from_secs(30),
+            "Esc did not quit"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    assert!(status.success(), "{status}\n{}", viewer.output());
+}

@@ -1,0 +1,208 @@
+//! The viewer's display pass (`shaders/display.wgsl`): shows the linear accumulation on a
+//! surface through the sRGB curve and an optional tone mapper, leaving it unchanged.
+
+use crate::error::RenderError;
+use crate::renderer::ProgressiveRenderer;
+use crate::shaders;
+
+/// How radiance is mapped to the display's [0, 1].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ToneMap {
+    /// Clamped: what `pathlight render` writes to PNG.
+    #[default]
+    Clamp,
+    /// The ACES filmic curve (Narkowicz's fit).
+    Aces,
+    /// AgX with its default look.
+    Agx,
+}
+
+impl ToneMap {
+    /// The next tone mapper in the cycle (the viewer's `T` key).
+    pub fn next(self) -> Self {
+        match self {
+            ToneMap::Clamp => ToneMap::Aces,
+            ToneMap::Aces => ToneMap::Agx,
+            ToneMap::Agx => ToneMap::Clamp,
+        }
+    }
+
+    /// Its name, for messages and the title.
+    pub fn name(self) -> &'static str {
+        match self {
+            ToneMap::Clamp => "clamp",
+            ToneMap::Aces => "ACES",
+            ToneMap::Agx => "AgX",
+        }
+    }
+
+    fn shader_value(self) -> u32 {
+        match self {
+            ToneMap::Clamp => 0,
+            ToneMap::Aces => 1,
+            ToneMap::Agx => 2,
+        }
+    }
+}
+
+/// Uniforms of the display pass. WGSL: `DisplayParams`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuDisplayParams {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel in rows `rows_ahead ..`.
+    pub samples: u32,
+    /// Rows holding one sample more (a frame in progress).
+    pub rows_ahead: u32,
+    /// Surface width in pixels.
+    pub target_width: f32,
+    /// Surface height in pixels.
+    pub target_height: f32,
+    /// The tone mapper (`TONEMAP_*` in the shader).
+    pub tonemap: u32,
+    /// 1 when the shader applies the sRGB curve (the surface format does not).
+    pub encode_srgb: u32,
+}
+const _: () = assert!(size_of::<GpuDisplayParams>() == 32);
+
+/// The display pipeline for one surface format.
+#[derive(Debug)]
+pub struct DisplayPass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    params_buffer: wgpu::Buffer,
+    encode_srgb: bool,
+}
+
+impl DisplayPass {
+    /// Creates the pipeline drawing into textures of `format`.
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Result<Self, RenderError> {
+        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("display"),
+            source: wgpu::ShaderSource::Wgsl(shaders::DISPLAY.into()),
+        });
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Buffer {
+                ty,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("display"),
+            entries: &[
+                entry(0, wgpu::BufferBindingType::Uniform),
+                entry(1, wgpu::BufferBindingType::Storage { read_only: true }),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("display"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("display"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vertex_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fragment_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(format.into())],
+            }),
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("display params"),
+            size: size_of::<GpuDisplayParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        if let Some(err) = pollster::block_on(scope.pop()) {
+            return Err(RenderError::Pipeline {
+                label: "display".into(),
+                message: err.to_string(),
+            });
+        }
+        Ok(Self {
+            pipeline,
+            layout,
+            params_buffer,
+            encode_srgb: !format.is_srgb(),
+        })
+    }
+
+    /// Draws `renderer`'s current image, scaled to fill `target` (`target_size` pixels).
+    pub fn draw(
+        &self,
+        renderer: &ProgressiveRenderer,
+        target: &wgpu::TextureView,
+        target_size: (u32, u32),
+        tonemap: ToneMap,
+    ) {
+        let ctx = renderer.context();
+        let (width, height) = renderer.size();
+        let params = GpuDisplayParams {
+            width,
+            height,
+            samples: renderer.samples_done(),
+            rows_ahead: renderer.rows_ahead(),
+            target_width: target_size.0.max(1) as f32,
+            target_height: target_size.1.max(1) as f32,
+            tonemap: tonemap.shader_value(),
+            encode_srgb: u32::from(self.encode_srgb),
+        };
+        ctx.queue
+            .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
+        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("display"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: self.params_buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: renderer.accumulation().as_entire_binding(),
+                },
+            ],
+        });
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("display"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: target,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                ..Default::default()
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        ctx.queue.submit([encoder.finish()]);
+    }
+}
