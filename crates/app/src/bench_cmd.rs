@@ -34,6 +34,8 @@ struct Measurement {
     height: u32,
     max_depth: u32,
     triangles: usize,
+    /// Entries of the traversal stack the scene needs (the integrator is compiled with it).
+    traversal_stack: u32,
     /// Seconds to build the BVH (both levels).
     bvh_build_s: f64,
     /// Seconds from the start of this configuration (the command's start for the first:
@@ -151,6 +153,7 @@ fn measure(
     let gpu_scene = GpuScene::build(scene);
     let bvh_build_s = build_start.elapsed().as_secs_f64();
     let triangles = gpu_scene.vertices.len() / 3;
+    let traversal_stack = gpu_scene.traversal_stack_bound();
     let mut renderer = Renderer::new(ctx, scene, gpu_scene, accel)?;
     let time_limit = Duration::from_secs_f64(args.time_limit.max(0.0));
 
@@ -196,6 +199,7 @@ fn measure(
         height,
         max_depth: scene.settings.max_depth,
         triangles,
+        traversal_stack,
         bvh_build_s,
         first_frame_s,
         warmup_frames,
@@ -237,8 +241,8 @@ fn print_single(report: &Report) {
         m.rays_per_sample
     );
     println!(
-        "first frame  {:.3} s after start (BVH build {:.3} s, {} triangles)",
-        m.first_frame_s, m.bvh_build_s, m.triangles
+        "first frame  {:.3} s after start (BVH build {:.3} s, {} triangles, stack {})",
+        m.first_frame_s, m.bvh_build_s, m.triangles, m.traversal_stack
     );
 }
 

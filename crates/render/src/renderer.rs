@@ -66,6 +66,10 @@ pub struct ProgressiveRenderer {
     params: GpuFrameParams,
     /// Rows of the frame in progress ([`Self::step_frame`]) that already hold its sample.
     rows_ahead: u32,
+    /// The acceleration scheme compiled into the pipeline.
+    accel: Accel,
+    /// Entries of the pipeline's traversal stack.
+    stack_size: u32,
     /// Samples per pixel accumulated so far.
     samples_done: u32,
     /// Current piece size: rows per dispatch and samples per pixel per dispatch.
@@ -109,13 +113,13 @@ impl ProgressiveRenderer {
                 storage_entry(2, false),
             ],
         });
-        let pipeline = create_compute_pipeline(
+        let stack_size = stack_size(gpu_scene);
+        let pipeline = integrator_pipeline(
             device,
-            "integrator",
-            &shaders::integrator_module(),
-            "render",
-            &[&scene_buffers.layout, &frame_layout],
-            &accel.pipeline_constants(),
+            &scene_buffers.layout,
+            &frame_layout,
+            accel,
+            stack_size,
         )?;
         let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame params"),
@@ -149,6 +153,8 @@ impl ProgressiveRenderer {
             frame_layout,
             frame_bind_group,
             rows_ahead: 0,
+            accel,
+            stack_size,
             rows_per_dispatch: params.height.min(WORKGROUP * 4),
             batch_samples: 1,
             adaptive: true,
@@ -264,6 +270,16 @@ impl ProgressiveRenderer {
             self.batch_samples = 1;
         }
         self.scene = SceneBuffers::upload(device, gpu_scene)?;
+        if stack_size(gpu_scene) > self.stack_size {
+            self.stack_size = stack_size(gpu_scene);
+            self.pipeline = integrator_pipeline(
+                device,
+                &self.scene.layout,
+                &self.frame_layout,
+                self.accel,
+                self.stack_size,
+            )?;
+        }
         self.params = params;
         self.restart();
         Ok(())
@@ -456,4 +472,27 @@ fn frame_bind_group(
         layout,
         entries: &entries,
     })
+}
+
+/// Traversal stack entries for `gpu_scene`: its bound, in steps of 8.
+fn stack_size(gpu_scene: &GpuScene) -> u32 {
+    gpu_scene.traversal_stack_bound().next_multiple_of(8)
+}
+
+/// The integrator pipeline with the given scheme and traversal stack.
+fn integrator_pipeline(
+    device: &wgpu::Device,
+    scene_layout: &wgpu::BindGroupLayout,
+    frame_layout: &wgpu::BindGroupLayout,
+    accel: Accel,
+    stack_size: u32,
+) -> Result<wgpu::ComputePipeline, RenderError> {
+    create_compute_pipeline(
+        device,
+        "integrator",
+        &shaders::with_stack_size(&shaders::integrator_module(), stack_size),
+        "render",
+        &[scene_layout, frame_layout],
+        &accel.pipeline_constants(),
+    )
 }

@@ -59,6 +59,14 @@ impl Iterations {
         (self.current, self.iters)
     }
 
+    /// Average frames per second of the current iteration so far (0 before its first frame).
+    pub fn fps(&self) -> f64 {
+        if self.time_in_current.is_zero() {
+            return 0.0;
+        }
+        f64::from(self.frames_in_current) / self.time_in_current.as_secs_f64()
+    }
+
     /// Records rendering time spent on the current iteration.
     pub fn add_time(&mut self, elapsed: Duration) {
         if self.phase == Phase::Running {
@@ -116,6 +124,10 @@ mod tests {
         it.add_time(Duration::from_millis(300));
         assert_eq!(it.frame_done(), None);
         assert_eq!(it.frame_done(), None);
+        assert!(
+            (it.fps() - 2.0 / 0.3).abs() < 1e-9,
+            "2 frames in 0.3 s so far"
+        );
         let finished = it.frame_done().expect("the third frame ends iteration 1");
         assert_eq!(finished.iteration, 1);
         assert!((finished.fps - 10.0).abs() < 1e-9, "3 frames in 0.3 s");

@@ -111,14 +111,12 @@ struct Pointer {
     modifiers: ModifiersState,
 }
 
-/// Title-bar statistics over the last interval.
+/// Rays per second over the last title interval.
 #[derive(Debug)]
-struct Stats {
+struct RayRate {
     since: Instant,
-    frames: u32,
     rays_at_start: u64,
-    fps: f64,
-    rays_per_second: f64,
+    per_second: f64,
 }
 
 /// The viewer's state.
@@ -133,7 +131,7 @@ struct Viewer {
     adapter_name: Option<String>,
     save_dir: PathBuf,
     pointer: Pointer,
-    stats: Stats,
+    ray_rate: RayRate,
     gpu: Option<Gpu>,
     error: Option<anyhow::Error>,
 }
@@ -151,12 +149,10 @@ impl Viewer {
             adapter_name: args.adapter.clone(),
             save_dir: args.save_dir.clone(),
             pointer: Pointer::default(),
-            stats: Stats {
+            ray_rate: RayRate {
                 since: Instant::now(),
-                frames: 0,
                 rays_at_start: 0,
-                fps: 0.0,
-                rays_per_second: 0.0,
+                per_second: 0.0,
             },
             gpu: None,
             error: None,
@@ -213,7 +209,7 @@ impl Viewer {
             gpu.window.request_redraw();
         }
         self.iterations.restart();
-        self.stats.rays_at_start = 0;
+        self.ray_rate.rays_at_start = 0;
         Ok(())
     }
 
@@ -236,7 +232,6 @@ impl Viewer {
                 if !frame_done {
                     continue;
                 }
-                self.stats.frames += 1;
                 if let Some(finished) = self.iterations.frame_done() {
                     say!(
                         "iter {} finished, {:.2} fps",
@@ -284,16 +279,14 @@ impl Viewer {
         let Some(gpu) = &self.gpu else {
             return Ok(());
         };
-        let elapsed = self.stats.since.elapsed();
+        let rate = &mut self.ray_rate;
+        let elapsed = rate.since.elapsed();
         if elapsed >= TITLE_INTERVAL {
             let rays = gpu.renderer.rays_traced()?;
-            let seconds = elapsed.as_secs_f64();
-            self.stats.fps = f64::from(self.stats.frames) / seconds;
-            self.stats.rays_per_second =
-                rays.saturating_sub(self.stats.rays_at_start) as f64 / seconds;
-            self.stats.since = Instant::now();
-            self.stats.frames = 0;
-            self.stats.rays_at_start = rays;
+            rate.per_second =
+                rays.saturating_sub(rate.rays_at_start) as f64 / elapsed.as_secs_f64();
+            rate.since = Instant::now();
+            rate.rays_at_start = rays;
         }
         let (iteration, iters) = self.iterations.position();
         let state = match (self.paused, self.iterations.phase()) {
@@ -302,11 +295,12 @@ impl Viewer {
             (false, Phase::Done) => " | done".to_string(),
             (false, Phase::Running) => String::new(),
         };
+        let fps = self.iterations.fps();
         gpu.window.set_title(&format!(
-            "pathlight | {} spp | iter {iteration}/{iters} | {:.1} fps | {:.1} M rays/s | {} | {}{state}",
+            "pathlight | {} spp | iter {iteration}/{iters} | {} fps | {:.1} M rays/s | {} | {}{state}",
             gpu.renderer.samples_done(),
-            self.stats.fps,
-            self.stats.rays_per_second / 1e6,
+            if fps < 10.0 { format!("{fps:.2}") } else { format!("{fps:.0}") },
+            rate.per_second / 1e6,
             gpu.adapter,
             self.tonemap.name(),
         ));

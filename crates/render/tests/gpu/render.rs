@@ -197,6 +197,47 @@ fn batching_does_not_change_the_image() {
     assert_eq!(render_with(Some((16, 3))), adaptive);
 }
 
+/// The viewer's schedule: frames rendered band by band (`step_frame`, a tiny time target so
+/// every band is one workgroup of rows), and the other ways to add frames, give the same
+/// image; mid-frame, the rows already sampled are divided by their own count; after
+/// `set_scene` with a new size and camera, the image is that of a fresh renderer.
+#[test]
+fn frames_in_bands_and_scene_changes_keep_the_image_exact() {
+    let s = scene("refs/cornell-spheres.toml", 24, 3, 4);
+    let gpu_scene = pathlight_core::GpuScene::build(&s);
+    let mut reference =
+        pathlight_render::ProgressiveRenderer::new(context(), &s, &gpu_scene).unwrap();
+    for _ in 0..3 {
+        reference.submit_frame();
+    }
+    reference.finish().unwrap();
+    let reference = reference.read_film().unwrap();
+    let mut r = pathlight_render::ProgressiveRenderer::new(context(), &s, &gpu_scene).unwrap();
+    let (mut frames, mut partials) = (0, 0);
+    while frames < 3 {
+        frames += u32::from(r.step_frame(std::time::Duration::ZERO).unwrap());
+        if frames == 2 && r.rows_ahead() > 0 {
+            // Mid-frame: the sampled rows equal a 3-sample image, the rest a 2-sample one.
+            let partial = r.read_film().unwrap();
+            let ahead = (r.rows_ahead() * 24) as usize;
+            assert_eq!(partial.pixels[..ahead], reference.pixels[..ahead]);
+            assert_ne!(partial.pixels[ahead..], reference.pixels[ahead..]);
+            partials += 1;
+        }
+    }
+    assert!(partials >= 2, "the third frame took {partials} + 1 bands");
+    assert_eq!(r.read_film().unwrap(), reference);
+
+    let mut moved = scene("refs/cornell-spheres.toml", 16, 2, 4);
+    moved.camera.position.x += 0.3;
+    r.set_scene(&moved, &gpu_scene).unwrap();
+    assert_eq!(r.samples_done(), 0);
+    for _ in 0..2 {
+        while !r.step_frame(std::time::Duration::ZERO).unwrap() {}
+    }
+    assert_eq!(r.read_film().unwrap(), render(&moved));
+}
+
 /// Same seed, same image, bit for bit, however the work is batched; another seed differs.
 #[test]
 fn seeds_are_deterministic() {

@@ -61,10 +61,14 @@ fn trace_on_gpu(gpu_scene: &GpuScene, rays: &[TraceRay], accel: Accel) -> Vec<Tr
         label: Some("trace test"),
         entries: &[storage_entry(0, true), storage_entry(1, false)],
     });
+    // The stack sized as the integrator sizes it: a bound too small would lose hits here.
     let source = format!(
         "const OBJECT_COUNT: u32 = {}u;\n{}{}",
         gpu_scene.object_count,
-        shaders::ray_query_library(),
+        shaders::with_stack_size(
+            &shaders::ray_query_library(),
+            gpu_scene.traversal_stack_bound()
+        ),
         KERNEL
     );
     let pipeline = create_compute_pipeline(
