@@ -106,118 +106,113 @@ fn shadow_ray(p: vec3f, ng: vec3f, ls: LightSample) -> ShadowRay {
     return ShadowRay(Ray(origin, to_light / distance), distance * (1.0 - 1e-4));
 }
 
-// A path in flight: what the next bounce needs.
-struct Path {
-    ray: Ray,
-    radiance: vec3f,
-    throughput: vec3f,
+// One path. Extension and shadow rays go through a single `trace_scene` call site (a shadow
+// ray is traced before the next extension ray), which keeps the kernel half as large as two
+// inlined traversals; the estimator and the order of every sum are those of the CPU twin.
+fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
+    var ray = first;
+    var radiance = vec3f(0.0);
+    var throughput = vec3f(1.0);
     // The BSDF sample that produced `ray`: its density and whether it was a delta lobe
     // (camera rays count as delta: emitters they see get full weight).
-    prev_pdf: f32,
-    prev_delta: bool,
-    prev_position: vec3f,
+    var prev_pdf = 0.0;
+    var prev_delta = true;
+    var prev_position = ray.origin;
     // Normal (on the side of wo) at the vertex that produced `ray`.
-    prev_normal: vec3f,
-    eta_scale: f32,
-    depth: u32,
+    var prev_normal = vec3f(0.0);
+    var eta_scale = 1.0;
+    var depth = 1u;
     // A shadow ray waiting to be traced, and the radiance it adds if nothing blocks it.
-    shadow: ShadowRay,
-    shadow_radiance: vec3f,
-    shadow_pending: bool,
+    var shadow = ShadowRay(first, 0.0);
+    var shadow_radiance = vec3f(0.0);
+    var shadow_pending = false;
     // Whether `ray` still has to be traced.
-    extend: bool,
-}
-
-fn start_path(first: Ray) -> Path {
-    return Path(first, vec3f(0.0), vec3f(1.0), 0.0, true, first.origin, vec3f(0.0), 1.0, 1u,
-        ShadowRay(first, 0.0), vec3f(0.0), false, true);
-}
-
-// Traces the path's next ray and follows up on the hit; returns whether the path goes on.
-// Extension and shadow rays go through this one `trace_scene` call site (a shadow ray is
-// traced before the next extension ray), which keeps the kernel half as large as two
-// inlined traversals; the estimator and the order of every sum are those of the CPU twin.
-fn advance_path(path: ptr<function, Path>, sampler: ptr<function, Sampler>) -> bool {
-    let is_shadow = (*path).shadow_pending;
-    var query = ShadowRay((*path).ray, T_MAX);
-    if is_shadow {
-        query = (*path).shadow;
-    }
-    let hit = trace_scene(query.ray, query.t_max, params.object_count, is_shadow);
-    rays_traced++;
-    if is_shadow {
-        (*path).shadow_pending = false;
+    var extend = true;
+    loop {
+        let is_shadow = shadow_pending;
+        var query = ShadowRay(ray, T_MAX);
+        if is_shadow {
+            query = shadow;
+        }
+        let hit = trace_scene(query.ray, query.t_max, params.object_count, is_shadow);
+        rays_traced++;
+        if is_shadow {
+            shadow_pending = false;
+            if hit.object == NO_HIT {
+                radiance += shadow_radiance;
+            }
+            if extend {
+                continue;
+            }
+            break;
+        }
+        extend = false;
         if hit.object == NO_HIT {
-            (*path).radiance += (*path).shadow_radiance;
+            var w = 1.0;
+            if !prev_delta {
+                w = power_heuristic(prev_pdf, env_pdf(prev_normal, ray.dir));
+            }
+            radiance += throughput * params.environment * w;
+            break;
         }
-        return (*path).extend;
-    }
-    (*path).extend = false;
-    let ray = (*path).ray;
-    if hit.object == NO_HIT {
-        var w = 1.0;
-        if !(*path).prev_delta {
-            w = power_heuristic((*path).prev_pdf, env_pdf((*path).prev_normal, ray.dir));
+        let s = surface_at(hit, ray);
+        let material = materials[s.material];
+        let wo = -ray.dir;
+        if dot(wo, s.ng) > 0.0 && max(max(material.emission.x, material.emission.y), material.emission.z) > 0.0 {
+            var w = 1.0;
+            if !prev_delta && objects[hit.object].light != NO_LIGHT {
+                w = power_heuristic(prev_pdf, light_pdf(hit.object, hit.primitive, prev_position, s.position, s.ng));
+            }
+            radiance += throughput * material.emission * w;
         }
-        (*path).radiance += (*path).throughput * params.environment * w;
-        return false;
-    }
-    let s = surface_at(hit, ray);
-    let material = materials[s.material];
-    let wo = -ray.dir;
-    if dot(wo, s.ng) > 0.0 && max(max(material.emission.x, material.emission.y), material.emission.z) > 0.0 {
-        var w = 1.0;
-        if !(*path).prev_delta && objects[hit.object].light != NO_LIGHT {
-            w = power_heuristic((*path).prev_pdf, light_pdf(hit.object, hit.primitive, (*path).prev_position, s.position, s.ng));
+        if depth == params.max_depth {
+            break;
         }
-        (*path).radiance += (*path).throughput * material.emission * w;
-    }
-    if (*path).depth == params.max_depth {
-        return false;
-    }
-    // Every bounce draws the same dimensions in the same order.
-    let u_light_select = next_1d(sampler);
-    let u_light = next_2d(sampler);
-    let u_lobe = next_1d(sampler);
-    let u_fresnel = next_1d(sampler);
-    let u_bsdf = next_2d(sampler);
-    let u_rr = next_1d(sampler);
-    let color = base_color(material, s.uv);
-    let n = select(-s.ns, s.ns, dot(wo, s.ng) >= 0.0);
-    if has_continuous_lobe(material) {
-        let ls = sample_light(s.position, n, u_light_select, u_light);
-        if ls.valid {
-            let e = eval_bsdf(material, color, s, wo, ls.wi);
-            if max(max(e.f.x, e.f.y), e.f.z) > 0.0 {
-                (*path).shadow = shadow_ray(s.position, s.ng, ls);
-                (*path).shadow_radiance = (*path).throughput * e.f * ls.radiance * power_heuristic(ls.pdf, e.pdf) / ls.pdf;
-                (*path).shadow_pending = true;
+        // Every bounce draws the same dimensions in the same order.
+        let u_light_select = next_1d(sampler);
+        let u_light = next_2d(sampler);
+        let u_lobe = next_1d(sampler);
+        let u_fresnel = next_1d(sampler);
+        let u_bsdf = next_2d(sampler);
+        let u_rr = next_1d(sampler);
+        let color = base_color(material, s.uv);
+        let n = select(-s.ns, s.ns, dot(wo, s.ng) >= 0.0);
+        if has_continuous_lobe(material) {
+            let ls = sample_light(s.position, n, u_light_select, u_light);
+            if ls.valid {
+                let e = eval_bsdf(material, color, s, wo, ls.wi);
+                if max(max(e.f.x, e.f.y), e.f.z) > 0.0 {
+                    shadow = shadow_ray(s.position, s.ng, ls);
+                    shadow_radiance = throughput * e.f * ls.radiance * power_heuristic(ls.pdf, e.pdf) / ls.pdf;
+                    shadow_pending = true;
+                }
             }
         }
-    }
-    let bs = sample_bsdf(material, color, s, wo, u_lobe, u_fresnel, u_bsdf);
-    if bs.valid {
-        (*path).throughput *= bs.weight;
-        (*path).prev_pdf = bs.pdf;
-        (*path).prev_delta = bs.delta;
-        (*path).prev_position = s.position;
-        (*path).prev_normal = n;
-        (*path).eta_scale *= bs.eta;
-        (*path).extend = true;
-        if (*path).depth >= params.rr_depth {
-            let t = (*path).throughput;
-            let eta2 = (*path).eta_scale * (*path).eta_scale;
-            let q = min(max(max(t.x, t.y), t.z) * eta2, 0.95);
-            if u_rr >= q {
-                (*path).extend = false;
-            } else {
-                (*path).throughput /= q;
+        let bs = sample_bsdf(material, color, s, wo, u_lobe, u_fresnel, u_bsdf);
+        if bs.valid {
+            throughput *= bs.weight;
+            prev_pdf = bs.pdf;
+            prev_delta = bs.delta;
+            prev_position = s.position;
+            prev_normal = n;
+            eta_scale *= bs.eta;
+            extend = true;
+            if depth >= params.rr_depth {
+                let q = min(max(max(throughput.x, throughput.y), throughput.z) * eta_scale * eta_scale, 0.95);
+                if u_rr >= q {
+                    extend = false;
+                } else {
+                    throughput /= q;
+                }
             }
+            ray = Ray(offset_origin(s.position, s.ng, bs.wi), bs.wi);
+            depth++;
         }
-        (*path).ray = Ray(offset_origin(s.position, s.ng, bs.wi), bs.wi);
-        (*path).depth++;
+        if !extend && !shadow_pending {
+            break;
+        }
     }
-    return (*path).extend || (*path).shadow_pending;
+    return radiance;
 }
 
 fn is_finite3(v: vec3f) -> bool {
@@ -225,49 +220,23 @@ fn is_finite3(v: vec3f) -> bool {
     return all(abs(v) <= vec3f(3.0e38));
 }
 
-// Pixels each invocation renders (a pipeline constant; the host sizes the dispatch by it).
-// An invocation starts its next path as soon as one ends, so a warp waits for the longest
-// sum of PIXELS_PER_INVOCATION paths rather than for its single longest path.
-override PIXELS_PER_INVOCATION: u32 = 1u;
-
-// Invocation (x, t) renders column x of rows row_offset + t + j * stride, j < PIXELS_PER_INVOCATION.
 @compute @workgroup_size(8, 8)
 fn render(@builtin(global_invocation_id) gid: vec3u, @builtin(local_invocation_index) local: u32) {
     let x = gid.x;
-    let rows = params.row_end - params.row_offset;
-    let stride = (rows + PIXELS_PER_INVOCATION - 1u) / PIXELS_PER_INVOCATION;
-    // Work items: (pixel j, sample i) as item j * batch_samples + i, those on rows inside
-    // the band.
-    var count = 0u;
-    if x < params.width && gid.y < stride {
-        count = min(PIXELS_PER_INVOCATION, (rows - gid.y + stride - 1u) / stride) * params.batch_samples;
-    }
-    var item = 0u;
-    var y = params.row_offset + gid.y;
-    var batch = AccumPixel(vec4u(0u), vec4u(0u));
-    var sampler = sampler_init(params.sampler, y * params.width + x, params.sample_offset, params.seed);
-    var path = start_path(camera_ray(x, y, &sampler));
-    while item < count {
-        if advance_path(&path, &sampler) {
-            continue;
+    let y = gid.y + params.row_offset;
+    if x < params.width && y < params.row_end {
+        let pixel = y * params.width + x;
+        var batch = AccumPixel(vec4u(0u), vec4u(0u));
+        for (var i = 0u; i < params.batch_samples; i++) {
+            var sampler = sampler_init(params.sampler, pixel, params.sample_offset + i, params.seed);
+            let radiance = trace_path(camera_ray(x, y, &sampler), &sampler);
+            if is_finite3(radiance) {
+                add_sample(&batch, radiance);
+            }
         }
-        if is_finite3(path.radiance) {
-            add_sample(&batch, path.radiance);
-        }
-        item++;
-        let sample = item % params.batch_samples;
-        if sample == 0u {
-            let pixel = y * params.width + x;
-            var total = accum[pixel];
-            add_fixed(&total, batch);
-            accum[pixel] = total;
-            batch = AccumPixel(vec4u(0u), vec4u(0u));
-            y += stride;
-        }
-        if item < count {
-            sampler = sampler_init(params.sampler, y * params.width + x, params.sample_offset + sample, params.seed);
-            path = start_path(camera_ray(x, y, &sampler));
-        }
+        var total = accum[pixel];
+        add_fixed(&total, batch);
+        accum[pixel] = total;
     }
     atomicAdd(&workgroup_rays, rays_traced);
     workgroupBarrier();

@@ -21,19 +21,6 @@ pub const TARGET_SUBMISSION: Duration = Duration::from_millis(100);
 const MAX_BATCH_SAMPLES: u32 = 256;
 /// Workgroup edge of the integrator (`@workgroup_size(8, 8)`).
 const WORKGROUP: u32 = 8;
-/// Pixels one invocation renders one after the other (WGSL `PIXELS_PER_INVOCATION`) on a
-/// CPU adapter: +13% on lavapipe, where a warp's lanes idle until its longest path ends.
-/// On a GPU, one: fewer invocations than the GPU holds cost more (an H100 ran the default
-/// scene 28% slower with four).
-const PIXELS_PER_INVOCATION_ON_CPU: u32 = 4;
-
-/// Pixels per invocation for the adapter `info` describes.
-fn pixels_per_invocation(info: &wgpu::AdapterInfo) -> u32 {
-    match info.device_type {
-        wgpu::DeviceType::Cpu => PIXELS_PER_INVOCATION_ON_CPU,
-        _ => 1,
-    }
-}
 
 /// How the integrator finds the nearest hit. Every scheme finds the same hit (a test checks
 /// it); the slower two reproduce the seed's frame-rate table (`pathlight bench --accel`).
@@ -53,13 +40,13 @@ impl Accel {
     pub const ALL: [Accel; 3] = [Accel::Bvh, Accel::BoundingVolume, Accel::BruteForce];
 
     /// The shader's `ACCEL` pipeline constant selecting this scheme (`bvh.wgsl`).
-    pub fn pipeline_constant(self) -> (&'static str, f64) {
+    pub fn pipeline_constants(self) -> [(&'static str, f64); 1] {
         let value = match self {
             Accel::Bvh => 0.0,
             Accel::BoundingVolume => 1.0,
             Accel::BruteForce => 2.0,
         };
-        ("ACCEL", value)
+        [("ACCEL", value)]
     }
 }
 
@@ -83,8 +70,6 @@ pub struct ProgressiveRenderer {
     accel: Accel,
     /// Entries of the pipeline's traversal stack.
     stack_size: u32,
-    /// Pixels each invocation renders (compiled into the pipeline).
-    pixels_per_invocation: u32,
     /// Samples per pixel accumulated so far.
     samples_done: u32,
     /// Current piece size: rows per dispatch and samples per pixel per dispatch.
@@ -129,12 +114,12 @@ impl ProgressiveRenderer {
             ],
         });
         let stack_size = stack_size(gpu_scene);
-        let pixels_per_invocation = pixels_per_invocation(&ctx.adapter_info);
         let pipeline = integrator_pipeline(
             device,
             &scene_buffers.layout,
             &frame_layout,
-            (accel, stack_size, pixels_per_invocation),
+            accel,
+            stack_size,
         )?;
         let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame params"),
@@ -170,7 +155,6 @@ impl ProgressiveRenderer {
             rows_ahead: 0,
             accel,
             stack_size,
-            pixels_per_invocation,
             rows_per_dispatch: params.height.min(WORKGROUP * 4),
             batch_samples: 1,
             adaptive: true,
@@ -186,24 +170,6 @@ impl ProgressiveRenderer {
         self.rows_per_dispatch = rows.clamp(1, self.params.height);
         self.batch_samples = samples.clamp(1, MAX_BATCH_SAMPLES);
         self.adaptive = false;
-    }
-
-    /// Sets how many pixels each invocation renders one after the other (by default four
-    /// on a CPU adapter, one on a GPU) and recompiles the pipeline. The image does not
-    /// depend on it.
-    pub fn set_pixels_per_invocation(&mut self, pixels: u32) -> Result<(), RenderError> {
-        self.pixels_per_invocation = pixels.max(1);
-        self.rebuild_pipeline()
-    }
-
-    fn rebuild_pipeline(&mut self) -> Result<(), RenderError> {
-        self.pipeline = integrator_pipeline(
-            &self.ctx.device,
-            &self.scene.layout,
-            &self.frame_layout,
-            (self.accel, self.stack_size, self.pixels_per_invocation),
-        )?;
-        Ok(())
     }
 
     /// Samples per pixel accumulated so far.
@@ -278,8 +244,7 @@ impl ProgressiveRenderer {
             pass.set_bind_group(1, &self.frame_bind_group, &[]);
             pass.dispatch_workgroups(
                 self.params.width.div_ceil(WORKGROUP),
-                rows.div_ceil(self.pixels_per_invocation)
-                    .div_ceil(WORKGROUP),
+                rows.div_ceil(WORKGROUP),
                 1,
             );
         }
@@ -307,7 +272,13 @@ impl ProgressiveRenderer {
         self.scene = SceneBuffers::upload(device, gpu_scene)?;
         if stack_size(gpu_scene) > self.stack_size {
             self.stack_size = stack_size(gpu_scene);
-            self.rebuild_pipeline()?;
+            self.pipeline = integrator_pipeline(
+                device,
+                &self.scene.layout,
+                &self.frame_layout,
+                self.accel,
+                self.stack_size,
+            )?;
         }
         self.params = params;
         self.restart();
@@ -508,13 +479,13 @@ fn stack_size(gpu_scene: &GpuScene) -> u32 {
     gpu_scene.traversal_stack_bound().next_multiple_of(8)
 }
 
-/// The integrator pipeline with the given scheme, traversal stack entries and pixels per
-/// invocation.
+/// The integrator pipeline with the given scheme and traversal stack.
 fn integrator_pipeline(
     device: &wgpu::Device,
     scene_layout: &wgpu::BindGroupLayout,
     frame_layout: &wgpu::BindGroupLayout,
-    (accel, stack_size, pixels_per_invocation): (Accel, u32, u32),
+    accel: Accel,
+    stack_size: u32,
 ) -> Result<wgpu::ComputePipeline, RenderError> {
     create_compute_pipeline(
         device,
@@ -522,9 +493,6 @@ fn integrator_pipeline(
         &shaders::with_stack_size(&shaders::integrator_module(), stack_size),
         "render",
         &[scene_layout, frame_layout],
-        &[
-            accel.pipeline_constant(),
-            ("PIXELS_PER_INVOCATION", f64::from(pixels_per_invocation)),
-        ],
+        &accel.pipeline_constants(),
     )
 }

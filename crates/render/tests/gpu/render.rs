@@ -195,20 +195,6 @@ fn batching_does_not_change_the_image() {
     let adaptive = render_with(None);
     assert_eq!(render_with(Some((5, 1))), adaptive);
     assert_eq!(render_with(Some((16, 3))), adaptive);
-    // Invocations rendering 1, 3 or 4 pixels in turn (the GPU and CPU-adapter schedules).
-    for pixels in [1, 3, 4] {
-        let mut r = pathlight_render::ProgressiveRenderer::new(context(), &s, &gpu_scene).unwrap();
-        r.set_pixels_per_invocation(pixels).unwrap();
-        r.set_piece(16, 2);
-        while r.samples_done() < 6 {
-            r.advance(6 - r.samples_done()).unwrap();
-        }
-        assert_eq!(
-            r.read_film().unwrap(),
-            adaptive,
-            "{pixels} pixels per invocation"
-        );
-    }
 }
 
 /// The viewer's schedule: frames rendered band by band (`step_frame`, a tiny time target so

@@ -77,7 +77,7 @@ fn trace_on_gpu(gpu_scene: &GpuScene, rays: &[TraceRay], accel: Accel) -> Vec<Tr
         &source,
         "trace",
         &[&scene.layout, &layout],
-        &[accel.pipeline_constant()],
+        &accel.pipeline_constants(),
     )
     .unwrap();
     let ray_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
