@@ -21,6 +21,8 @@ const NO_HIT: u32 = 0xffffffffu;
 // and the end of the BLAS being walked.
 const ENTER_MESH: u32 = 0x80000000u;
 const LEAVE_MESH: u32 = 0xffffffffu;
+// No node left to visit.
+const NO_NODE: u32 = 0xffffffffu;
 
 struct Hit {
     t: f32,
@@ -110,31 +112,11 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
     var index = 0u;
     // The mesh whose BLAS is being walked, or NO_HIT in the top level.
     var mesh = NO_HIT;
+    // "While-while" (Aila and Laine): a warp's lanes walk inner nodes together, then
+    // intersect leaves together, instead of alternating between the two each step.
     loop {
-        let node = nodes[index];
-        var descend = false;
-        if node.prim_count > 0u {
-            if mesh != NO_HIT {
-                intersect_triangles(mesh, node.first_index, node.prim_count, ray, &hit);
-            } else {
-                for (var i = node.first_index; i < node.first_index + node.prim_count; i++) {
-                    let o = objects[i];
-                    if o.kind != KIND_MESH {
-                        intersect_shape(i, o, ray, &hit);
-                    } else if sp < STACK_SIZE {
-                        let t = intersect_aabb(nodes[o.blas_root], ray.origin, inv_dir, hit.t);
-                        if t != MISS {
-                            stack_node[sp] = ENTER_MESH | i;
-                            stack_t[sp] = t;
-                            sp++;
-                        }
-                    }
-                }
-            }
-            if any_hit && hit.object != NO_HIT {
-                break;
-            }
-        } else {
+        var node = nodes[index];
+        while node.prim_count == 0u {
             let a = node.first_index;
             let ta = intersect_aabb(nodes[a], ray.origin, inv_dir, hit.t);
             let tb = intersect_aabb(nodes[a + 1u], ray.origin, inv_dir, hit.t);
@@ -146,40 +128,73 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
                     stack_t[sp] = max(ta, tb);
                     sp++;
                 }
-                descend = true;
             } else if ta != MISS || tb != MISS {
                 index = select(a + 1u, a, ta != MISS);
-                descend = true;
-            }
-        }
-        if !descend {
-            // Pop the next entry still nearer than the current hit.
-            var found = false;
-            while sp > 0u {
-                sp--;
-                let entry = stack_node[sp];
-                if entry == LEAVE_MESH {
-                    mesh = NO_HIT;
-                } else if stack_t[sp] < hit.t {
-                    if (entry & ENTER_MESH) != 0u {
-                        mesh = entry & ~ENTER_MESH;
-                        index = objects[mesh].blas_root;
-                        // The slot just freed holds the marker below the BLAS entries.
-                        stack_node[sp] = LEAVE_MESH;
-                        sp++;
-                    } else {
-                        index = entry;
-                    }
-                    found = true;
-                    break;
+            } else {
+                index = pop_entry(&stack_node, &stack_t, &sp, &mesh, hit.t);
+                if index == NO_NODE {
+                    return hit;
                 }
             }
-            if !found {
-                break;
+            node = nodes[index];
+        }
+        if mesh != NO_HIT {
+            intersect_triangles(mesh, node.first_index, node.prim_count, ray, &hit);
+        } else {
+            for (var i = node.first_index; i < node.first_index + node.prim_count; i++) {
+                let o = objects[i];
+                if o.kind != KIND_MESH {
+                    intersect_shape(i, o, ray, &hit);
+                } else if sp < STACK_SIZE {
+                    let t = intersect_aabb(nodes[o.blas_root], ray.origin, inv_dir, hit.t);
+                    if t != MISS {
+                        stack_node[sp] = ENTER_MESH | i;
+                        stack_t[sp] = t;
+                        sp++;
+                    }
+                }
             }
+        }
+        if any_hit && hit.object != NO_HIT {
+            return hit;
+        }
+        index = pop_entry(&stack_node, &stack_t, &sp, &mesh, hit.t);
+        if index == NO_NODE {
+            return hit;
         }
     }
     return hit;
+}
+
+// Pops the next entry whose subtree may hold a hit nearer than `t` and returns its node, or
+// NO_NODE when none is left; entering or leaving a mesh's BLAS on the way updates `mesh`.
+fn pop_entry(
+    stack_node: ptr<function, array<u32, STACK_SIZE>>,
+    stack_t: ptr<function, array<f32, STACK_SIZE>>,
+    sp: ptr<function, u32>,
+    mesh: ptr<function, u32>,
+    t: f32,
+) -> u32 {
+    while *sp > 0u {
+        *sp -= 1u;
+        let entry = (*stack_node)[*sp];
+        if entry == LEAVE_MESH {
+            *mesh = NO_HIT;
+            continue;
+        }
+        if (*stack_t)[*sp] >= t {
+            continue;
+        }
+        if (entry & ENTER_MESH) != 0u {
+            *mesh = entry & ~ENTER_MESH;
+            // The slot just freed holds the marker below the BLAS entries.
+            (*stack_node)[*sp] = LEAVE_MESH;
+            *sp += 1u;
+            return objects[*mesh].blas_root;
+        }
+        return entry;
+    }
+    return NO_NODE;
 }
 
 // Nearest hit in (0, t_max) over the whole scene.
