@@ -298,9 +298,9 @@ impl ProgressiveRenderer {
         self.rows_ahead += rows;
         // Next band: scale by the measured time, in whole workgroups of rows.
         let scale = target.as_secs_f64() / elapsed.as_secs_f64().max(1e-6);
-        let next = (f64::from(rows) * scale.clamp(0.5, 2.0)) as u32;
+        let workgroups = (f64::from(rows) * scale.clamp(0.5, 2.0) / f64::from(WORKGROUP)).round();
         self.rows_per_dispatch =
-            (next / WORKGROUP * WORKGROUP).clamp(WORKGROUP.min(height), height);
+            (workgroups as u32 * WORKGROUP).clamp(WORKGROUP.min(height), height);
         if self.rows_ahead < height {
             return Ok(false);
         }
