@@ -3,6 +3,7 @@
 
 use crate::error::RenderError;
 use crate::renderer::ProgressiveRenderer;
+use crate::scene_buffers::bind_buffers;
 use crate::shaders;
 
 /// How radiance is mapped to the display's [0, 1].
@@ -170,20 +171,12 @@ impl DisplayPass {
         };
         ctx.queue
             .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
-        let bind_group = ctx.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("display"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: self.params_buffer.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: renderer.accumulation().as_entire_binding(),
-                },
-            ],
-        });
+        let bind_group = bind_buffers(
+            &ctx.device,
+            "display",
+            &self.layout,
+            &[&self.params_buffer, renderer.accumulation()],
+        );
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -12,7 +12,7 @@ use pathlight_core::{Film, GpuScene, Scene};
 
 use crate::context::GpuContext;
 use crate::error::RenderError;
-use crate::scene_buffers::{SceneBuffers, create_compute_pipeline, storage_entry};
+use crate::scene_buffers::{SceneBuffers, bind_buffers, create_compute_pipeline, storage_entry};
 use crate::shaders;
 
 /// Aimed-for GPU time of one submission.
@@ -459,19 +459,7 @@ fn frame_bind_group(
     accum: &wgpu::Buffer,
     ray_counter: &wgpu::Buffer,
 ) -> wgpu::BindGroup {
-    let entries: Vec<_> = [params, accum, ray_counter]
-        .iter()
-        .enumerate()
-        .map(|(i, b)| wgpu::BindGroupEntry {
-            binding: i as u32,
-            resource: b.as_entire_binding(),
-        })
-        .collect();
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("frame"),
-        layout,
-        entries: &entries,
-    })
+    bind_buffers(device, "frame", layout, &[params, accum, ray_counter])
 }
 
 /// Traversal stack entries for `gpu_scene`: its bound, in steps of 8.

@@ -62,21 +62,32 @@ impl SceneBuffers {
             label: Some("scene layout"),
             entries: &(0..7).map(|i| storage_entry(i, true)).collect::<Vec<_>>(),
         });
-        let entries: Vec<_> = buffers
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: b.as_entire_binding(),
-            })
-            .collect();
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scene"),
-            layout: &layout,
-            entries: &entries,
-        });
+        let buffers: Vec<&wgpu::Buffer> = buffers.iter().collect();
+        let bind_group = bind_buffers(device, "scene", &layout, &buffers);
         Ok(Self { layout, bind_group })
     }
+}
+
+/// A bind group of `layout` binding `buffers[i]`, whole, at binding `i`.
+pub fn bind_buffers(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
+    let entries: Vec<_> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: b.as_entire_binding(),
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
 }
 
 /// Creates a compute pipeline inside an error scope so a shader mismatch is an error;
