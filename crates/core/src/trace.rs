@@ -1,7 +1,7 @@
 //! Ray queries on a [`GpuScene`] on the CPU: the twin of `intersect.wgsl` and `bvh.wgsl`
 //! (same names, same arithmetic), used to check the GPU traversal and for picking.
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 use crate::accel::GpuScene;
 use crate::gpu::{FLAG_CAPS, GpuBvhNode, KIND_MESH, KIND_QUAD, KIND_SPHERE};
@@ -36,17 +36,16 @@ pub struct Hit {
 }
 
 /// Slab test; twin of WGSL `intersect_aabb`. Returns the entry distance or [`MISS`].
+///
+/// In SIMD lanes (`Vec3A`): its min and max skip the NaN handling of `f32::min`, which cost a
+/// fifth of the traversal; no NaN can arise (`inv_dir` is finite, see [`safe_inverse`]), and
+/// min and max are exact, so the result is the WGSL twin's bit for bit.
 pub fn intersect_aabb(node: &GpuBvhNode, origin: Vec3, inv_dir: Vec3, t_max: f32) -> f32 {
-    let t0 = (Vec3::from(node.aabb_min) - origin) * inv_dir;
-    let t1 = (Vec3::from(node.aabb_max) - origin) * inv_dir;
-    let t_near =
-        t0.x.min(t1.x)
-            .max(t0.y.min(t1.y))
-            .max(t0.z.min(t1.z).max(0.0));
-    let t_far =
-        t0.x.max(t1.x)
-            .min(t0.y.max(t1.y))
-            .min(t0.z.max(t1.z).min(t_max));
+    let (origin, inv_dir) = (Vec3A::from(origin), Vec3A::from(inv_dir));
+    let t0 = (Vec3A::from(node.aabb_min) - origin) * inv_dir;
+    let t1 = (Vec3A::from(node.aabb_max) - origin) * inv_dir;
+    let t_near = t0.min(t1).max_element().max(0.0);
+    let t_far = t0.max(t1).min_element().min(t_max);
     if t_near <= t_far { t_near } else { MISS }
 }
 
