@@ -8,7 +8,7 @@ use pathlight_core::{GpuScene, Scene};
 use pathlight_render::{Accel, GpuContext};
 use serde::Serialize;
 
-use crate::cli::{AccelArg, BenchArgs};
+use crate::cli::BenchArgs;
 use crate::setup::{Renderer, device_name, load_scene, open_context};
 
 /// A timed chunk of GPU frames grows until it takes about this long, so a fast GPU is not
@@ -77,12 +77,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             })
             .collect()
     } else {
-        let accel = match args.accel {
-            AccelArg::Bvh => Accel::Bvh,
-            AccelArg::BoundingVolume => Accel::BoundingVolume,
-            AccelArg::BruteForce => Accel::BruteForce,
-        };
-        vec![(accel_name(accel).into(), accel, args.without.clone(), None)]
+        let accel = Accel::from(args.accel);
+        vec![(accel.name().into(), accel, args.without.clone(), None)]
     };
     let mut report = Report {
         pathlight: env!("CARGO_PKG_VERSION"),
@@ -114,14 +110,6 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
         print_single(&report);
     }
     Ok(())
-}
-
-fn accel_name(accel: Accel) -> &'static str {
-    match accel {
-        Accel::Bvh => "bvh",
-        Accel::BoundingVolume => "bounding-volume",
-        Accel::BruteForce => "brute-force",
-    }
 }
 
 /// The scene without the objects named in `names`; every name must exist.
@@ -193,7 +181,7 @@ fn measure(
     let samples = f64::from(frames) * f64::from(width) * f64::from(height);
     Ok(Measurement {
         label: String::new(),
-        accel: accel_name(accel).into(),
+        accel: accel.name().into(),
         without: Vec::new(),
         width,
         height,

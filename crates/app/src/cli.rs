@@ -98,6 +98,16 @@ pub enum AccelArg {
     BruteForce,
 }
 
+impl From<AccelArg> for pathlight_render::Accel {
+    fn from(arg: AccelArg) -> Self {
+        match arg {
+            AccelArg::Bvh => Self::Bvh,
+            AccelArg::BoundingVolume => Self::BoundingVolume,
+            AccelArg::BruteForce => Self::BruteForce,
+        }
+    }
+}
+
 /// Options of `pathlight bench`.
 #[derive(Debug, clap::Args)]
 pub struct BenchArgs {
@@ -146,7 +156,7 @@ pub struct ViewArgs {
     pub iters: u32,
     /// Emitted radiance of a clicked object per unit of its base colour (default: the
     /// brightest emission in the scene).
-    #[arg(long, value_name = "STRENGTH")]
+    #[arg(long, value_name = "STRENGTH", value_parser = positive_strength, allow_negative_numbers = true)]
     pub light_strength: Option<f32>,
     /// Where `S` saves images.
     #[arg(long, default_value = ".", value_name = "DIR")]
@@ -173,5 +183,13 @@ impl ViewArgs {
             save_dir: ".".into(),
             adapter: None,
         }
+    }
+}
+
+/// Parses `--light-strength`: a finite number above zero.
+fn positive_strength(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("{text:?} is not a positive finite number")),
     }
 }

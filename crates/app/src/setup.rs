@@ -74,7 +74,8 @@ impl Renderer {
             )?),
             None if accel != Accel::Bvh => {
                 anyhow::bail!(
-                    "--accel {accel:?} needs the GPU backend; the CPU backend has only the BVH"
+                    "--accel {} needs the GPU backend; the CPU backend has only the BVH",
+                    accel.name()
                 )
             }
             None => Renderer::Cpu(CpuRenderer::new(scene, gpu_scene)),

@@ -240,3 +240,79 @@ fn viewer_without_a_display_suggests_render() {
         );
     }
 }
+
+/// `pathlight bench --json` (CPU backend, so it runs anywhere): the figures hang together.
+#[test]
+fn bench_reports_consistent_figures_as_json() {
+    let args = [
+        "bench",
+        "--backend",
+        "cpu",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--frames",
+        "3",
+        "--warmup",
+        "1",
+        "--json",
+    ];
+    let output = pathlight(&args);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let report: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
+    assert_eq!(report["backend"], "cpu");
+    let run = &report["runs"][0];
+    assert_eq!(run["frames"], 3);
+    assert_eq!(run["triangles"], 6208, "the default scene's vase");
+    let number = |key: &str| run[key].as_f64().unwrap_or_else(|| panic!("{key}: {run}"));
+    let (fps, seconds) = (number("fps"), number("seconds"));
+    assert!(
+        (fps * seconds - 3.0).abs() < 1e-6,
+        "fps {fps} over {seconds} s"
+    );
+    assert!((number("samples_per_s") - fps * 256.0).abs() < 1e-6 * fps * 256.0);
+    // Every sample traces its camera ray; at most two rays per segment of max_depth 8.
+    let rays = number("rays_per_sample");
+    assert!((1.0..=16.0).contains(&rays), "{rays} rays per sample");
+    assert!(number("rays_per_s") > 0.0 && number("first_frame_s") > 0.0);
+}
+
+/// Bad bench and view options are refused with the value named.
+#[test]
+fn bench_and_view_refuse_bad_options() {
+    fails_with(
+        &[
+            "bench",
+            "--backend",
+            "cpu",
+            "--without",
+            "teapot",
+            "--frames",
+            "1",
+        ],
+        &["\"teapot\"", "vase"],
+    );
+    fails_with(
+        &[
+            "bench",
+            "--backend",
+            "cpu",
+            "--accel",
+            "brute-force",
+            "--frames",
+            "1",
+        ],
+        &["brute-force", "GPU backend"],
+    );
+    for strength in ["-1", "0", "nan"] {
+        let output = pathlight(&["view", "--light-strength", strength]);
+        let err = stderr(&output);
+        assert_eq!(
+            output.status.code(),
+            Some(2),
+            "{strength}: clap's usage error\n{err}"
+        );
+        assert!(err.contains("positive finite number"), "{strength}:\n{err}");
+    }
+}

@@ -338,13 +338,13 @@ impl GpuScene {
         hit
     }
 
-    /// Nearest hit in `(0, t_max)`; twin of WGSL `intersect_scene`.
+    /// Nearest hit in `(0, t_max)`; twin of WGSL `trace_scene` without `any_hit`.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         let hit = self.trace(ray, t_max, false);
         (hit.object != u32::MAX).then_some(hit)
     }
 
-    /// Whether anything lies on the ray in `(0, t_max)`; twin of WGSL `any_hit_scene`.
+    /// Whether anything lies on the ray in `(0, t_max)`; twin of WGSL `trace_scene` with `any_hit`.
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.trace(ray, t_max, true).object != u32::MAX
     }

@@ -196,13 +196,3 @@ fn pop_entry(
     }
     return NO_NODE;
 }
-
-// Nearest hit in (0, t_max) over the whole scene.
-fn intersect_scene(ray: Ray, t_max: f32, object_count: u32) -> Hit {
-    return trace_scene(ray, t_max, object_count, false);
-}
-
-// Whether anything lies on the ray in (0, t_max).
-fn any_hit_scene(ray: Ray, t_max: f32, object_count: u32) -> bool {
-    return trace_scene(ray, t_max, object_count, true).object != NO_HIT;
-}

@@ -39,6 +39,15 @@ impl Accel {
     /// All schemes, fastest first.
     pub const ALL: [Accel; 3] = [Accel::Bvh, Accel::BoundingVolume, Accel::BruteForce];
 
+    /// Its name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Accel::Bvh => "bvh",
+            Accel::BoundingVolume => "bounding-volume",
+            Accel::BruteForce => "brute-force",
+        }
+    }
+
     /// The shader's `ACCEL` pipeline constant selecting this scheme (`bvh.wgsl`).
     pub fn pipeline_constants(self) -> [(&'static str, f64); 1] {
         let value = match self {

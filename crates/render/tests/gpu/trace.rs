@@ -28,8 +28,8 @@ fn trace(@builtin(global_invocation_id) gid: vec3u) {
         return;
     }
     let r = rays[i];
-    let hit = intersect_scene(Ray(r.origin, r.dir), r.t_max, OBJECT_COUNT);
-    let blocked = any_hit_scene(Ray(r.origin, r.dir), r.t_max, OBJECT_COUNT);
+    let hit = trace_scene(Ray(r.origin, r.dir), r.t_max, OBJECT_COUNT, false);
+    let blocked = trace_scene(Ray(r.origin, r.dir), r.t_max, OBJECT_COUNT, true).object != NO_HIT;
     hits[i] = TraceHit(hit.t, hit.object, hit.primitive, select(0u, 1u, blocked));
 }
 "#;
