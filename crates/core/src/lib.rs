@@ -14,9 +14,11 @@ pub mod revolve;
 pub mod scene;
 pub mod texture;
 pub mod trace;
+pub mod wide_bvh;
 
 pub use accel::GpuScene;
 pub use error::SceneError;
 pub use film::Film;
 pub use load::{SceneSource, load_scene, load_scene_file};
 pub use scene::{Camera, Material, Object, RenderSettings, Scene, Shape};
+pub use wide_bvh::WideBvh;

@@ -1,11 +1,12 @@
-//! The BVH: structure validated after every build, and traversal compared with brute force
-//! on random rays, for random, empty and degenerate scenes.
+//! The BVH: structure validated after every build, and both traversals (the WGSL twin in
+//! `trace` and the CPU's 4-wide `WideBvh`) compared with brute force on random rays, for
+//! random, empty and degenerate scenes.
 
 use glam::{Vec2, Vec3};
 use pathlight_core::gpu::{GpuBvhNode, KIND_MESH};
 use pathlight_core::scene::{Camera, Lobes, Material, RenderSettings, TriangleMesh};
 use pathlight_core::trace::{Hit, Ray, intersect_triangle};
-use pathlight_core::{GpuScene, Object, Scene, Shape};
+use pathlight_core::{GpuScene, Object, Scene, Shape, WideBvh};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
@@ -212,36 +213,52 @@ fn random_ray(rng: &mut StdRng, target: f32) -> Ray {
     }
 }
 
+/// Checks both traversals against brute force on `rays`; returns how many rays hit.
 fn assert_same(gpu: &GpuScene, rays: &[Ray]) -> usize {
+    let wide = WideBvh::build(gpu);
+    let traversals: [(
+        &str,
+        &dyn Fn(&Ray, f32) -> Option<Hit>,
+        &dyn Fn(&Ray, f32) -> bool,
+    ); 2] = [
+        ("twin", &|r, t| gpu.intersect(r, t), &|r, t| {
+            gpu.occluded(r, t)
+        }),
+        ("wide", &|r, t| wide.intersect(gpu, r, t), &|r, t| {
+            wide.occluded(gpu, r, t)
+        }),
+    ];
     let mut hits = 0;
     for ray in rays {
-        let fast = gpu.intersect(ray, 1e30);
         let slow = brute_force(gpu, ray, 1e30);
-        // The shadow-ray query: blocked exactly when the nearest hit lies before t_max.
-        for t_max in [0.5, 2.0, 1e30] {
-            let blocked = slow.is_some_and(|h| h.t < t_max);
-            assert_eq!(
-                gpu.occluded(ray, t_max),
-                blocked,
-                "ray {ray:?}, t_max {t_max}"
-            );
-        }
-        match (fast, slow) {
-            (None, None) => {}
-            (Some(a), Some(b)) => {
-                hits += 1;
-                assert!(
-                    (a.t - b.t).abs() <= 1e-5 * b.t.max(1.0),
-                    "ray {ray:?}: bvh t {} vs brute force {}",
-                    a.t,
-                    b.t
+        hits += usize::from(slow.is_some());
+        for (name, intersect, occluded) in &traversals {
+            let fast = intersect(ray, 1e30);
+            // The shadow-ray query: blocked exactly when the nearest hit lies before t_max.
+            for t_max in [0.5, 2.0, 1e30] {
+                let blocked = slow.is_some_and(|h| h.t < t_max);
+                assert_eq!(
+                    occluded(ray, t_max),
+                    blocked,
+                    "{name}: ray {ray:?}, t_max {t_max}"
                 );
-                if (a.t - b.t).abs() > 1e-7 * b.t {
-                    continue; // equal distances on two primitives: either answer is right
-                }
-                assert_eq!(a.object, b.object, "ray {ray:?}");
             }
-            (a, b) => panic!("ray {ray:?}: bvh {a:?} vs brute force {b:?}"),
+            match (fast, slow) {
+                (None, None) => {}
+                (Some(a), Some(b)) => {
+                    assert!(
+                        (a.t - b.t).abs() <= 1e-5 * b.t.max(1.0),
+                        "{name}: ray {ray:?}: bvh t {} vs brute force {}",
+                        a.t,
+                        b.t
+                    );
+                    if (a.t - b.t).abs() > 1e-7 * b.t {
+                        continue; // equal distances on two primitives: either answer is right
+                    }
+                    assert_eq!(a.object, b.object, "{name}: ray {ray:?}");
+                }
+                (a, b) => panic!("{name}: ray {ray:?}: bvh {a:?} vs brute force {b:?}"),
+            }
         }
     }
     hits
@@ -281,8 +298,12 @@ fn empty_scene_has_no_hits() {
     let gpu = GpuScene::build(&scene_of(Vec::new()));
     assert_eq!(gpu.object_count, 0);
     let mut rng = StdRng::seed_from_u64(1);
+    let wide = WideBvh::build(&gpu);
     for _ in 0..100 {
-        assert_eq!(gpu.intersect(&random_ray(&mut rng, 3.0), 1e30), None);
+        let ray = random_ray(&mut rng, 3.0);
+        assert_eq!(gpu.intersect(&ray, 1e30), None);
+        assert_eq!(wide.intersect(&gpu, &ray, 1e30), None);
+        assert!(!wide.occluded(&gpu, &ray, 1e30));
     }
 }
 

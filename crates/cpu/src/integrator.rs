@@ -2,9 +2,9 @@
 //! `integrator.wgsl` (same loop, same order of sample dimensions).
 
 use glam::Vec3;
-use pathlight_core::GpuScene;
 use pathlight_core::gpu::{GpuFrameParams, NO_LIGHT};
 use pathlight_core::trace::Ray;
+use pathlight_core::{GpuScene, WideBvh};
 
 use crate::bsdf::{eval_bsdf, has_continuous_lobe, sample_bsdf};
 use crate::lights::{LightSample, env_pdf, light_pdf, sample_light};
@@ -40,10 +40,10 @@ pub fn camera_ray(params: &GpuFrameParams, x: u32, y: u32, sampler: &mut Sampler
 /// Whether anything blocks the light sample `ls` from surface point `p` (normal `ng`).
 /// The shadow ray runs from the offset origin to the light point itself, stopping just
 /// short of it, so the light never shadows itself. Twin of WGSL `occluded`.
-fn occluded(scene: &GpuScene, p: Vec3, ng: Vec3, ls: &LightSample) -> bool {
+fn occluded(scene: &GpuScene, bvh: &WideBvh, p: Vec3, ng: Vec3, ls: &LightSample) -> bool {
     let origin = offset_origin(p, ng, ls.wi);
     if !ls.finite {
-        return scene.occluded(&Ray { origin, dir: ls.wi }, T_MAX);
+        return bvh.occluded(scene, &Ray { origin, dir: ls.wi }, T_MAX);
     }
     let to_light = ls.point - origin;
     let distance = to_light.length();
@@ -51,7 +51,7 @@ fn occluded(scene: &GpuScene, p: Vec3, ng: Vec3, ls: &LightSample) -> bool {
         origin,
         dir: to_light / distance,
     };
-    scene.occluded(&ray, distance * (1.0 - 1e-4))
+    bvh.occluded(scene, &ray, distance * (1.0 - 1e-4))
 }
 
 /// What one camera path brought back.
@@ -63,9 +63,11 @@ pub struct PathSample {
     pub rays: u32,
 }
 
-/// Radiance along one camera path. Twin of WGSL `trace_path`.
+/// Radiance along one camera path, its rays traced in `bvh` (built from `scene`). Twin of
+/// WGSL `trace_path`.
 pub fn trace_path(
     scene: &GpuScene,
+    bvh: &WideBvh,
     params: &GpuFrameParams,
     first: Ray,
     sampler: &mut Sampler,
@@ -88,7 +90,7 @@ pub fn trace_path(
     let environment = Vec3::from(params.environment);
     for depth in 1..=params.max_depth {
         rays += 1;
-        let Some(hit) = scene.intersect(&ray, T_MAX) else {
+        let Some(hit) = bvh.intersect(scene, &ray, T_MAX) else {
             let w = if prev_delta {
                 1.0
             } else {
@@ -137,7 +139,7 @@ pub fn trace_path(
                 let e = eval_bsdf(material, color, &s, wo, ls.wi);
                 if e.f.max_element() > 0.0 {
                     rays += 1;
-                    if !occluded(scene, s.position, s.ng, &ls) {
+                    if !occluded(scene, bvh, s.position, s.ng, &ls) {
                         radiance += throughput * e.f * ls.radiance * power_heuristic(ls.pdf, e.pdf)
                             / ls.pdf;
                     }

@@ -13,7 +13,7 @@ use std::time::{Duration, Instant};
 
 use pathlight_core::frame::frame_params;
 use pathlight_core::gpu::GpuFrameParams;
-use pathlight_core::{Film, GpuScene, Scene};
+use pathlight_core::{Film, GpuScene, Scene, WideBvh};
 use rayon::prelude::*;
 
 use crate::integrator::{accumulated_value, camera_ray, trace_path};
@@ -26,6 +26,8 @@ const TARGET_BATCH: Duration = Duration::from_millis(250);
 #[derive(Debug)]
 pub struct CpuRenderer {
     scene: GpuScene,
+    /// The scene's 4-wide BVH, which the CPU traces rays in.
+    bvh: WideBvh,
     params: GpuFrameParams,
     /// Per pixel, the sum of accumulated samples (f64: exact enough for any sample count).
     sums: Vec<[f64; 3]>,
@@ -41,6 +43,7 @@ impl CpuRenderer {
         let params = frame_params(scene, &gpu_scene);
         let pixels = (params.width * params.height) as usize;
         Self {
+            bvh: WideBvh::build(&gpu_scene),
             scene: gpu_scene,
             params,
             sums: vec![[0.0; 3]; pixels],
@@ -69,7 +72,8 @@ impl CpuRenderer {
             return 0;
         }
         let started = Instant::now();
-        let (scene, params, offset) = (&self.scene, &self.params, self.samples_done);
+        let (scene, bvh, params) = (&self.scene, &self.bvh, &self.params);
+        let offset = self.samples_done;
         let width = params.width as usize;
         let rays: u64 = self
             .sums
@@ -83,7 +87,7 @@ impl CpuRenderer {
                         let mut sampler =
                             Sampler::new(params.sampler, pixel, offset + i, params.seed);
                         let ray = camera_ray(params, x as u32, y as u32, &mut sampler);
-                        let path = trace_path(scene, params, ray, &mut sampler);
+                        let path = trace_path(scene, bvh, params, ray, &mut sampler);
                         rays += u64::from(path.rays);
                         let value = accumulated_value(path.radiance);
                         for c in 0..3 {

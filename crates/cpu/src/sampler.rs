@@ -11,11 +11,22 @@ use glam::Vec2;
 use pathlight_core::gpu::SAMPLER_SOBOL;
 
 /// PCG hash (Jarzynski and Olano, JCGT 2020). Twin of WGSL `pcg_hash`.
-pub fn pcg_hash(v: u32) -> u32 {
+pub const fn pcg_hash(v: u32) -> u32 {
     let state = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
     let word = ((state >> ((state >> 28) + 4)) ^ state).wrapping_mul(277_803_737);
     (word >> 22) ^ word
 }
+
+/// `pcg_hash` of the first dimension numbers (a path of depth 8 uses 2 + 7 * 6 = 44).
+const DIMENSION_HASHES: [u32; 64] = {
+    let mut table = [0; 64];
+    let mut i = 0;
+    while i < 64 {
+        table[i] = pcg_hash(i as u32);
+        i += 1;
+    }
+    table
+};
 
 /// Seed of `pixel` for `sample_index` under `seed`. Twin of WGSL `rng_init`.
 pub fn rng_init(pixel: u32, sample_index: u32, seed: u32) -> u32 {
@@ -33,28 +44,25 @@ fn laine_karras(mut x: u32, seed: u32) -> u32 {
     x
 }
 
-/// Owen scrambling from high bits to low. Twin of WGSL `nested_uniform_scramble`.
-fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
-    laine_karras(x.reverse_bits(), seed).reverse_bits()
-}
-
-/// Sobol dimension 0 (van der Corput). Twin of WGSL `sobol_0`.
-fn sobol_0(index: u32) -> u32 {
-    index.reverse_bits()
-}
-
-/// Sobol dimension 1 (primitive polynomial x + 1): the generator matrix is the binary
-/// Pascal matrix, so by Lucas' theorem bit p of the result (from the top) is the XOR of the
-/// index bits k that are supersets of p: a superset-XOR transform, then reversed. Twin of
-/// WGSL `sobol_1`.
-fn sobol_1(index: u32) -> u32 {
+/// Sobol dimension 1 (primitive polynomial x + 1) before its final bit reversal: the
+/// generator matrix is the binary Pascal matrix, so by Lucas' theorem bit p of the value
+/// (from the top) is the XOR of the index bits k that are supersets of p, a superset-XOR
+/// transform. Twin of WGSL `sobol_1_reversed`.
+fn sobol_1_reversed(index: u32) -> u32 {
     let mut y = index;
     y ^= (y >> 1) & 0x5555_5555;
     y ^= (y >> 2) & 0x3333_3333;
     y ^= (y >> 4) & 0x0f0f_0f0f;
     y ^= (y >> 8) & 0x00ff_00ff;
     y ^= (y >> 16) & 0x0000_ffff;
-    y.reverse_bits()
+    y
+}
+
+/// Owen scrambling (from high bits to low) of a Sobol value given bit-reversed, as
+/// `laine_karras` scrambles from low to high: `reverse(laine_karras(reverse(v)))` where
+/// `v` is the value, without reversing it twice. Twin of WGSL `owen_scramble_reversed`.
+fn owen_scramble_reversed(reversed: u32, seed: u32) -> u32 {
+    laine_karras(reversed, seed).reverse_bits()
 }
 
 /// The top 24 bits of `x` as a float in [0, 1). Twin of WGSL `to_unit_float`.
@@ -67,7 +75,8 @@ fn to_unit_float(x: u32) -> f32 {
 pub struct Sampler {
     kind: u32,
     pixel_seed: u32,
-    index: u32,
+    /// The sample index, bit-reversed (the shuffle scrambles it from the top).
+    index_reversed: u32,
     dimension: u32,
     rng_state: u32,
 }
@@ -78,7 +87,7 @@ impl Sampler {
         Self {
             kind,
             pixel_seed: pcg_hash(pixel ^ pcg_hash(seed)),
-            index,
+            index_reversed: index.reverse_bits(),
             dimension: 0,
             rng_state: rng_init(pixel, index, seed),
         }
@@ -95,9 +104,19 @@ impl Sampler {
     }
 
     fn dimension_seed(&mut self) -> u32 {
-        let seed = pcg_hash(self.pixel_seed ^ pcg_hash(self.dimension));
+        let hash = match DIMENSION_HASHES.get(self.dimension as usize) {
+            Some(&hash) => hash,
+            None => pcg_hash(self.dimension),
+        };
+        let seed = pcg_hash(self.pixel_seed ^ hash);
         self.dimension += 1;
         seed
+    }
+
+    /// The shuffled Sobol index of the dimension seeded `seed`: the sample index
+    /// Owen-scrambled. Twin of WGSL `shuffled_index`.
+    fn shuffled_index(&self, seed: u32) -> u32 {
+        owen_scramble_reversed(self.index_reversed, seed)
     }
 
     /// The next value in [0, 1). Twin of WGSL `next_1d`.
@@ -106,8 +125,9 @@ impl Sampler {
             return self.next_random();
         }
         let seed = self.dimension_seed();
-        let index = nested_uniform_scramble(self.index, seed);
-        to_unit_float(nested_uniform_scramble(sobol_0(index), pcg_hash(seed ^ 1)))
+        let index = self.shuffled_index(seed);
+        // Dimension 0 is the index reversed (van der Corput).
+        to_unit_float(owen_scramble_reversed(index, pcg_hash(seed ^ 1)))
     }
 
     /// The next point in [0, 1)^2, stratified with the other samples of the pixel. Twin of
@@ -118,10 +138,13 @@ impl Sampler {
             return Vec2::new(x, self.next_random());
         }
         let seed = self.dimension_seed();
-        let index = nested_uniform_scramble(self.index, seed);
+        let index = self.shuffled_index(seed);
         Vec2::new(
-            to_unit_float(nested_uniform_scramble(sobol_0(index), pcg_hash(seed ^ 1))),
-            to_unit_float(nested_uniform_scramble(sobol_1(index), pcg_hash(seed ^ 2))),
+            to_unit_float(owen_scramble_reversed(index, pcg_hash(seed ^ 1))),
+            to_unit_float(owen_scramble_reversed(
+                sobol_1_reversed(index),
+                pcg_hash(seed ^ 2),
+            )),
         )
     }
 }
@@ -130,6 +153,47 @@ impl Sampler {
 mod tests {
     use super::*;
     use pathlight_core::gpu::SAMPLER_INDEPENDENT;
+
+    /// Sobol dimension 0 (van der Corput).
+    fn sobol_0(index: u32) -> u32 {
+        index.reverse_bits()
+    }
+
+    /// Sobol dimension 1.
+    fn sobol_1(index: u32) -> u32 {
+        sobol_1_reversed(index).reverse_bits()
+    }
+
+    /// Owen scrambling from high bits to low, as written in Burley's paper.
+    fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
+        laine_karras(x.reverse_bits(), seed).reverse_bits()
+    }
+
+    #[test]
+    fn sampler_values_are_the_papers_composition() {
+        // Burley's listing: index = nus(i, seed); x = nus(sobol_0(index), hash(seed ^ 1)),
+        // y = nus(sobol_1(index), hash(seed ^ 2)); the sampler skips reversals that cancel.
+        for (pixel, i) in [(0, 0), (7, 1), (1234, 77), (99_999, 65_535), (3, u32::MAX)] {
+            let mut s = Sampler::new(SAMPLER_SOBOL, pixel, i, 5);
+            let pixel_seed = pcg_hash(pixel ^ pcg_hash(5));
+            for dimension in 0..70u32 {
+                let seed = pcg_hash(pixel_seed ^ pcg_hash(dimension));
+                let index = nested_uniform_scramble(i, seed);
+                let x = to_unit_float(nested_uniform_scramble(sobol_0(index), pcg_hash(seed ^ 1)));
+                if dimension % 3 == 0 {
+                    assert_eq!(s.next_1d(), x, "pixel {pixel}, sample {i}, dim {dimension}");
+                } else {
+                    let y = nested_uniform_scramble(sobol_1(index), pcg_hash(seed ^ 2));
+                    let expected = Vec2::new(x, to_unit_float(y));
+                    assert_eq!(
+                        s.next_2d(),
+                        expected,
+                        "pixel {pixel}, sample {i}, dim {dimension}"
+                    );
+                }
+            }
+        }
+    }
 
     /// Dimension 1 from its direction numbers v_0 = 2^31, v_b = v_(b-1) ^ (v_(b-1) >> 1).
     fn sobol_1_by_direction_numbers(index: u32) -> u32 {

@@ -29,27 +29,25 @@ fn laine_karras(v: u32, seed: u32) -> u32 {
     return x;
 }
 
-fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
-    return reverseBits(laine_karras(reverseBits(x), seed));
-}
-
-// Sobol dimension 0 (van der Corput: the bits reversed).
-fn sobol_0(index: u32) -> u32 {
-    return reverseBits(index);
-}
-
-// Sobol dimension 1 (primitive polynomial x + 1): its generator matrix is the binary
-// Pascal matrix, so by Lucas' theorem bit p of the result (counted from the top) is the
-// XOR of the index bits k that are supersets of p: a superset-XOR transform in five
-// bit-parallel steps, then reversed.
-fn sobol_1(index: u32) -> u32 {
+// Sobol dimension 1 (primitive polynomial x + 1) before its final bit reversal: its
+// generator matrix is the binary Pascal matrix, so by Lucas' theorem bit p of the value
+// (counted from the top) is the XOR of the index bits k that are supersets of p: a
+// superset-XOR transform in five bit-parallel steps. (Dimension 0, van der Corput, is the
+// index reversed.)
+fn sobol_1_reversed(index: u32) -> u32 {
     var y = index;
     y ^= (y >> 1u) & 0x55555555u;
     y ^= (y >> 2u) & 0x33333333u;
     y ^= (y >> 4u) & 0x0f0f0f0fu;
     y ^= (y >> 8u) & 0x00ff00ffu;
     y ^= (y >> 16u) & 0x0000ffffu;
-    return reverseBits(y);
+    return y;
+}
+
+// Owen scrambling (high bits to low) of a Sobol value given bit-reversed:
+// reverseBits(laine_karras(reverseBits(v))) without reversing v twice.
+fn owen_scramble_reversed(reversed: u32, seed: u32) -> u32 {
+    return reverseBits(laine_karras(reversed, seed));
 }
 
 fn to_unit_float(x: u32) -> f32 {
@@ -59,13 +57,13 @@ fn to_unit_float(x: u32) -> f32 {
 struct Sampler {
     kind: u32,
     pixel_seed: u32,
-    index: u32,
+    index_reversed: u32,
     dimension: u32,
     rng_state: u32,
 }
 
 fn sampler_init(kind: u32, pixel: u32, index: u32, seed: u32) -> Sampler {
-    return Sampler(kind, pcg_hash(pixel ^ pcg_hash(seed)), index, 0u, rng_init(pixel, index, seed));
+    return Sampler(kind, pcg_hash(pixel ^ pcg_hash(seed)), reverseBits(index), 0u, rng_init(pixel, index, seed));
 }
 
 fn next_random(s: ptr<function, Sampler>) -> f32 {
@@ -81,13 +79,18 @@ fn dimension_seed(s: ptr<function, Sampler>) -> u32 {
     return seed;
 }
 
+// The dimension's shuffled Sobol index: the sample index Owen-scrambled.
+fn shuffled_index(s: ptr<function, Sampler>, seed: u32) -> u32 {
+    return owen_scramble_reversed((*s).index_reversed, seed);
+}
+
 fn next_1d(s: ptr<function, Sampler>) -> f32 {
     if (*s).kind != SAMPLER_SOBOL {
         return next_random(s);
     }
     let seed = dimension_seed(s);
-    let index = nested_uniform_scramble((*s).index, seed);
-    return to_unit_float(nested_uniform_scramble(sobol_0(index), pcg_hash(seed ^ 1u)));
+    let index = shuffled_index(s, seed);
+    return to_unit_float(owen_scramble_reversed(index, pcg_hash(seed ^ 1u)));
 }
 
 fn next_2d(s: ptr<function, Sampler>) -> vec2f {
@@ -96,9 +99,9 @@ fn next_2d(s: ptr<function, Sampler>) -> vec2f {
         return vec2f(x, next_random(s));
     }
     let seed = dimension_seed(s);
-    let index = nested_uniform_scramble((*s).index, seed);
+    let index = shuffled_index(s, seed);
     return vec2f(
-        to_unit_float(nested_uniform_scramble(sobol_0(index), pcg_hash(seed ^ 1u))),
-        to_unit_float(nested_uniform_scramble(sobol_1(index), pcg_hash(seed ^ 2u))),
+        to_unit_float(owen_scramble_reversed(index, pcg_hash(seed ^ 1u))),
+        to_unit_float(owen_scramble_reversed(sobol_1_reversed(index), pcg_hash(seed ^ 2u))),
     );
 }

@@ -1,0 +1,335 @@
+//! The CPU's acceleration structure: [`GpuScene`]'s binary BVHs collapsed into 4-wide ones,
+//! whose four child boxes are tested at once in SIMD lanes (glam's `Vec4`: SSE on x86-64).
+//!
+//! A ray visits about half as many nodes as in the binary tree and tests their children in
+//! one go. The primitive tests are [`crate::trace`]'s, the WGSL twins, so hits are the same;
+//! only the order of the walk differs (which can change the answer between two primitives at
+//! exactly the same distance).
+
+use std::cell::RefCell;
+use std::ops::Range;
+
+use glam::{Vec3, Vec4};
+
+use crate::accel::GpuScene;
+use crate::gpu::{GpuBvhNode, KIND_MESH};
+use crate::trace::{Hit, Ray, intersect_triangle_edges, safe_inverse};
+
+/// Four child boxes in structure-of-arrays form, and what each child is.
+#[derive(Debug, Clone, Copy)]
+struct Node4 {
+    /// Per axis x, y, z: the children's minimum coordinates. An unused lane holds an
+    /// inverted box (+inf to -inf) that no ray enters.
+    lo: [Vec4; 3],
+    /// Per axis: the children's maximum coordinates.
+    hi: [Vec4; 3],
+    /// Per child: the index of an inner node, or a leaf's first primitive.
+    first: [u32; 4],
+    /// Per child: the number of primitives of a leaf; 0 for an inner node or an unused lane.
+    count: [u32; 4],
+}
+
+/// A 4-wide BVH over a [`GpuScene`]: one tree over the objects and one per mesh.
+#[derive(Debug, Clone, Default)]
+pub struct WideBvh {
+    /// Every tree's nodes; the top level's root is node 0 (when there are objects).
+    nodes: Vec<Node4>,
+    /// Per object of the scene: the root of its mesh's tree (unused for other shapes).
+    mesh_roots: Vec<u32>,
+    /// Per triangle: its first corner and the two edges from it (`intersect_triangle`'s
+    /// subtractions done once, with the same results).
+    triangles: Vec<[Vec3; 3]>,
+    /// Whether the scene has any object.
+    has_objects: bool,
+}
+
+/// A node still to visit, and the distance at which the ray enters its box.
+#[derive(Debug, Clone, Copy)]
+struct Entry {
+    node: u32,
+    t: f32,
+}
+
+thread_local! {
+    /// Each thread's traversal stack, reused so that a ray query allocates nothing.
+    static STACK: RefCell<Vec<Entry>> = const { RefCell::new(Vec::new()) };
+}
+
+/// The ray in the form the box tests want: its origin and inverse direction splatted across
+/// lanes, and per axis whether it runs backwards (so the maximum planes are the near ones).
+struct RayLanes {
+    origin: [Vec4; 3],
+    inv_dir: [Vec4; 3],
+    backwards: [bool; 3],
+}
+
+impl RayLanes {
+    fn new(ray: &Ray) -> Self {
+        let inv = safe_inverse(ray.dir);
+        Self {
+            origin: [
+                Vec4::splat(ray.origin.x),
+                Vec4::splat(ray.origin.y),
+                Vec4::splat(ray.origin.z),
+            ],
+            inv_dir: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
+            backwards: [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0],
+        }
+    }
+
+    /// Entry distances of the four child boxes of `node` (clamped at 0) and the bit mask of
+    /// those the ray enters before `t_max`. Per lane the same products as the WGSL slab
+    /// test, with the min/max of each pair chosen by the direction's sign.
+    fn enter(&self, node: &Node4, t_max: f32) -> (Vec4, u32) {
+        let mut t_near = Vec4::ZERO;
+        let mut t_far = Vec4::splat(t_max);
+        for axis in 0..3 {
+            let (near, far) = if self.backwards[axis] {
+                (node.hi[axis], node.lo[axis])
+            } else {
+                (node.lo[axis], node.hi[axis])
+            };
+            let (o, inv) = (self.origin[axis], self.inv_dir[axis]);
+            t_near = t_near.max((near - o) * inv);
+            t_far = t_far.min((far - o) * inv);
+        }
+        (t_near, t_near.cmple(t_far).bitmask())
+    }
+}
+
+impl WideBvh {
+    /// Collapses the binary trees of `scene` (its top level and every mesh's BLAS).
+    pub fn build(scene: &GpuScene) -> Self {
+        let mut bvh = Self {
+            has_objects: scene.object_count > 0,
+            ..Self::default()
+        };
+        if bvh.has_objects {
+            bvh.collapse(&scene.nodes, 0);
+        }
+        bvh.mesh_roots = scene
+            .objects
+            .iter()
+            .map(|o| {
+                if o.kind == KIND_MESH {
+                    bvh.collapse(&scene.nodes, o.blas_root)
+                } else {
+                    0
+                }
+            })
+            .collect();
+        bvh.triangles = (0..(scene.vertices.len() / 3) as u32)
+            .map(|i| {
+                let [v0, v1, v2] = scene.triangle(i);
+                [v0, v1 - v0, v2 - v0]
+            })
+            .collect();
+        bvh
+    }
+
+    /// Appends the 4-wide form of the binary subtree at `root`; returns its node index.
+    /// Each wide node takes the binary node's children and keeps opening its largest inner
+    /// child (by surface area) until it has four.
+    fn collapse(&mut self, nodes: &[GpuBvhNode], root: u32) -> u32 {
+        let index = self.nodes.len() as u32;
+        self.nodes.push(Node4 {
+            lo: [Vec4::INFINITY; 3],
+            hi: [Vec4::NEG_INFINITY; 3],
+            first: [0; 4],
+            count: [0; 4],
+        });
+        let node = &nodes[root as usize];
+        let mut children: Vec<u32> = if node.prim_count > 0 {
+            vec![root]
+        } else {
+            vec![node.first_index, node.first_index + 1]
+        };
+        while children.len() < 4 {
+            let widest = children
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| nodes[**c as usize].prim_count == 0)
+                .max_by(|(_, a), (_, b)| {
+                    half_area(&nodes[**a as usize]).total_cmp(&half_area(&nodes[**b as usize]))
+                })
+                .map(|(i, _)| i);
+            let Some(i) = widest else { break };
+            let opened = children.swap_remove(i);
+            let first = nodes[opened as usize].first_index;
+            children.extend([first, first + 1]);
+        }
+        for (lane, &child) in children.iter().enumerate() {
+            let c = &nodes[child as usize];
+            let (first, count) = if c.prim_count > 0 {
+                (c.first_index, c.prim_count)
+            } else {
+                (self.collapse(nodes, child), 0)
+            };
+            let n = &mut self.nodes[index as usize];
+            for axis in 0..3 {
+                n.lo[axis][lane] = c.aabb_min[axis];
+                n.hi[axis][lane] = c.aabb_max[axis];
+            }
+            n.first[lane] = first;
+            n.count[lane] = count;
+        }
+        index
+    }
+
+    /// Nearest hit in `(0, t_max)`.
+    pub fn intersect(&self, scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let hit = self.trace(scene, ray, t_max, false);
+        (hit.object != u32::MAX).then_some(hit)
+    }
+
+    /// Whether anything lies on the ray in `(0, t_max)`.
+    pub fn occluded(&self, scene: &GpuScene, ray: &Ray, t_max: f32) -> bool {
+        self.trace(scene, ray, t_max, true).object != u32::MAX
+    }
+
+    fn trace(&self, scene: &GpuScene, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
+        let mut hit = Hit {
+            t: t_max,
+            object: u32::MAX,
+            primitive: 0,
+            b1: 0.0,
+            b2: 0.0,
+        };
+        if self.has_objects {
+            let lanes = RayLanes::new(ray);
+            STACK.with_borrow_mut(|stack| {
+                stack.clear();
+                let walk = Walk {
+                    bvh: self,
+                    scene,
+                    ray,
+                    lanes: &lanes,
+                    any_hit,
+                };
+                walk.tree(stack, 0, &mut hit, |stack, range, hit| {
+                    walk.objects(stack, range, hit)
+                });
+            });
+        }
+        hit
+    }
+}
+
+/// Half the surface area of a binary node's box.
+fn half_area(node: &GpuBvhNode) -> f32 {
+    let d = Vec3::from(node.aabb_max) - Vec3::from(node.aabb_min);
+    d.x * d.y + d.y * d.z + d.z * d.x
+}
+
+/// One ray query in progress.
+struct Walk<'a> {
+    bvh: &'a WideBvh,
+    scene: &'a GpuScene,
+    ray: &'a Ray,
+    lanes: &'a RayLanes,
+    any_hit: bool,
+}
+
+impl Walk<'_> {
+    /// Walks the tree at `root`, nearest boxes first, using `stack` above its current
+    /// length. Leaves go to `leaf` as their node is visited (nearest first); inner nodes are
+    /// pushed. Returns false as soon as `leaf` does (an any-hit query has its answer).
+    #[inline]
+    fn tree(
+        &self,
+        stack: &mut Vec<Entry>,
+        root: u32,
+        hit: &mut Hit,
+        mut leaf: impl FnMut(&mut Vec<Entry>, Range<u32>, &mut Hit) -> bool,
+    ) -> bool {
+        let base = stack.len();
+        let mut node = root;
+        loop {
+            let n = &self.bvh.nodes[node as usize];
+            let (t_near, mut mask) = self.lanes.enter(n, hit.t);
+            // The entered children, nearest first.
+            let mut order = [(0.0f32, 0usize); 4];
+            let mut entered = 0;
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let t = t_near[lane];
+                let mut k = entered;
+                while k > 0 && order[k - 1].0 > t {
+                    order[k] = order[k - 1];
+                    k -= 1;
+                }
+                order[k] = (t, lane);
+                entered += 1;
+            }
+            for &(t, lane) in &order[..entered] {
+                if n.count[lane] > 0 && t < hit.t {
+                    let (first, count) = (n.first[lane], n.count[lane]);
+                    if !leaf(stack, first..first + count, hit) {
+                        return false;
+                    }
+                }
+            }
+            for &(t, lane) in order[..entered].iter().rev() {
+                if n.count[lane] == 0 {
+                    stack.push(Entry {
+                        node: n.first[lane],
+                        t,
+                    });
+                }
+            }
+            loop {
+                if stack.len() == base {
+                    return true;
+                }
+                let Some(entry) = stack.pop() else {
+                    return true;
+                };
+                if entry.t < hit.t {
+                    node = entry.node;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Tests the top-level objects `range`, walking the tree of each mesh among them.
+    /// Returns false once an any-hit query has its answer.
+    #[inline]
+    fn objects(&self, stack: &mut Vec<Entry>, range: Range<u32>, hit: &mut Hit) -> bool {
+        for i in range {
+            if self.scene.objects[i as usize].kind == KIND_MESH {
+                let root = self.bvh.mesh_roots[i as usize];
+                let found = !self.tree(stack, root, hit, |_, triangles, hit| {
+                    self.triangles(i, triangles, hit)
+                });
+                if found {
+                    return false;
+                }
+            } else {
+                self.scene.intersect_shape(i, self.ray, hit);
+            }
+        }
+        !(self.any_hit && hit.object != u32::MAX)
+    }
+
+    /// Tests the triangles `range` of mesh object `object`. Returns false once an any-hit
+    /// query has its answer.
+    #[inline]
+    fn triangles(&self, object: u32, range: Range<u32>, hit: &mut Hit) -> bool {
+        for tri in range {
+            let [v0, e1, e2] = self.bvh.triangles[tri as usize];
+            let (t, b1, b2) = intersect_triangle_edges(v0, e1, e2, self.ray, hit.t);
+            if t < hit.t {
+                *hit = Hit {
+                    t,
+                    object,
+                    primitive: tri,
+                    b1,
+                    b2,
+                };
+            }
+        }
+        !(self.any_hit && hit.object != u32::MAX)
+    }
+}
