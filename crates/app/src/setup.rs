@@ -46,7 +46,11 @@ pub fn open_context(args: &DeviceArgs) -> anyhow::Result<Option<GpuContext>> {
 pub fn device_name(ctx: Option<&GpuContext>) -> String {
     match ctx {
         Some(ctx) => describe(&ctx.adapter_info),
-        None => format!("cpu backend, {} threads", rayon::current_num_threads()),
+        None => format!(
+            "cpu backend, {} threads, {}",
+            rayon::current_num_threads(),
+            pathlight_cpu::InstructionSet::best().name()
+        ),
     }
 }
 

@@ -50,6 +50,7 @@ pub fn intersect_aabb(node: &GpuBvhNode, origin: Vec3, inv_dir: Vec3, t_max: f32
 }
 
 /// `1 / d` without infinities; twin of WGSL `safe_inverse`.
+#[inline(always)]
 pub fn safe_inverse(d: Vec3) -> Vec3 {
     let tiny = 1e-20_f32;
     let fix = |c: f32| {
@@ -63,6 +64,7 @@ pub fn safe_inverse(d: Vec3) -> Vec3 {
 }
 
 /// Parallelogram; twin of WGSL `intersect_quad`. Returns `(t, s, t_param)`.
+#[inline(always)]
 pub fn intersect_quad(origin: Vec3, eu: Vec3, ev: Vec3, ray: &Ray, t_max: f32) -> (f32, f32, f32) {
     let n = eu.cross(ev);
     let denom = n.dot(ray.dir);
@@ -84,6 +86,7 @@ pub fn intersect_quad(origin: Vec3, eu: Vec3, ev: Vec3, ray: &Ray, t_max: f32) -
 }
 
 /// Sphere; twin of WGSL `intersect_sphere`.
+#[inline(always)]
 pub fn intersect_sphere(center: Vec3, radius: f32, ray: &Ray, t_max: f32) -> f32 {
     let oc = ray.origin - center;
     let b = -oc.dot(ray.dir);
@@ -156,6 +159,7 @@ pub fn intersect_triangle(v0: Vec3, v1: Vec3, v2: Vec3, ray: &Ray, t_max: f32) -
 }
 
 /// [`intersect_triangle`] given the edges `e1 = v1 - v0` and `e2 = v2 - v0`.
+#[inline(always)]
 pub fn intersect_triangle_edges(
     v0: Vec3,
     e1: Vec3,
@@ -206,6 +210,7 @@ impl GpuScene {
 
     /// Nearest hit on quad, sphere or cylinder `i` (top-level order), updating `hit`; twin
     /// of WGSL `intersect_shape`.
+    #[inline(always)]
     pub fn intersect_shape(&self, i: u32, ray: &Ray, hit: &mut Hit) {
         let o = &self.objects[i as usize];
         let a = Vec3::from_slice(&o.a);

@@ -64,6 +64,7 @@ struct RayLanes {
 }
 
 impl RayLanes {
+    #[inline(always)]
     fn new(ray: &Ray) -> Self {
         let inv = safe_inverse(ray.dir);
         Self {
@@ -80,6 +81,7 @@ impl RayLanes {
     /// Entry distances of the four child boxes of `node` (clamped at 0) and the bit mask of
     /// those the ray enters before `t_max`. Per lane the same products as the WGSL slab
     /// test, with the min/max of each pair chosen by the direction's sign.
+    #[inline(always)]
     fn enter(&self, node: &Node4, t_max: f32) -> (Vec4, u32) {
         let mut t_near = Vec4::ZERO;
         let mut t_far = Vec4::splat(t_max);
@@ -177,16 +179,19 @@ impl WideBvh {
     }
 
     /// Nearest hit in `(0, t_max)`.
+    #[inline(always)]
     pub fn intersect(&self, scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<Hit> {
         let hit = self.trace(scene, ray, t_max, false);
         (hit.object != u32::MAX).then_some(hit)
     }
 
     /// Whether anything lies on the ray in `(0, t_max)`.
+    #[inline(always)]
     pub fn occluded(&self, scene: &GpuScene, ray: &Ray, t_max: f32) -> bool {
         self.trace(scene, ray, t_max, true).object != u32::MAX
     }
 
+    #[inline(always)]
     fn trace(&self, scene: &GpuScene, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
         let mut hit = Hit {
             t: t_max,

@@ -213,14 +213,17 @@ fn random_ray(rng: &mut StdRng, target: f32) -> Ray {
     }
 }
 
+/// A traversal's name, nearest-hit query and shadow query.
+type Traversal<'a> = (
+    &'a str,
+    &'a dyn Fn(&Ray, f32) -> Option<Hit>,
+    &'a dyn Fn(&Ray, f32) -> bool,
+);
+
 /// Checks both traversals against brute force on `rays`; returns how many rays hit.
 fn assert_same(gpu: &GpuScene, rays: &[Ray]) -> usize {
     let wide = WideBvh::build(gpu);
-    let traversals: [(
-        &str,
-        &dyn Fn(&Ray, f32) -> Option<Hit>,
-        &dyn Fn(&Ray, f32) -> bool,
-    ); 2] = [
+    let traversals: [Traversal; 2] = [
         ("twin", &|r, t| gpu.intersect(r, t), &|r, t| {
             gpu.occluded(r, t)
         }),

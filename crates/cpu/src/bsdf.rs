@@ -164,6 +164,7 @@ fn fresnel_dielectric_local(cos_om: f32, ior: f32) -> f32 {
 }
 
 /// The continuous part of the BSDF. Twin of WGSL `eval_bsdf`.
+#[inline(always)]
 pub fn eval_bsdf(m: &GpuMaterial, color: Vec3, s: &Surface, wo: Vec3, wi: Vec3) -> BsdfEval {
     let weights = lobe_weights(m);
     let front = wo.dot(s.ng) >= 0.0;
@@ -291,6 +292,7 @@ fn mixture_sample(m: &GpuMaterial, color: Vec3, s: &Surface, wo: Vec3, wi: Vec3)
 }
 
 /// Samples an incident direction. Twin of WGSL `sample_bsdf`.
+#[inline(always)]
 pub fn sample_bsdf(
     m: &GpuMaterial,
     color: Vec3,
@@ -422,6 +424,7 @@ fn sample_smooth_dielectric(
 
 /// Whether the material has a non-delta lobe (next-event estimation is worth doing).
 /// Twin of WGSL `has_continuous_lobe`.
+#[inline(always)]
 pub fn has_continuous_lobe(m: &GpuMaterial) -> bool {
     let w = lobe_weights(m);
     w.x > 0.0

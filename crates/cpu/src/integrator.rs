@@ -18,12 +18,14 @@ const T_MAX: f32 = 1.0e30;
 
 /// Start of a ray leaving `p` on the side of `ng` that `dir` points to. Twin of WGSL
 /// `offset_origin`.
+#[inline(always)]
 fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
     let eps = 1e-4 * (1.0 + p.abs().max_element());
     p + if dir.dot(ng) > 0.0 { ng } else { -ng } * eps
 }
 
 /// Camera ray through a jittered point of pixel (x, y). Twin of WGSL `camera_ray`.
+#[inline(always)]
 pub fn camera_ray(params: &GpuFrameParams, x: u32, y: u32, sampler: &mut Sampler) -> Ray {
     let jitter = sampler.next_2d();
     let ndc_x = 2.0 * (x as f32 + jitter.x) / params.width as f32 - 1.0;
@@ -40,6 +42,7 @@ pub fn camera_ray(params: &GpuFrameParams, x: u32, y: u32, sampler: &mut Sampler
 /// Whether anything blocks the light sample `ls` from surface point `p` (normal `ng`).
 /// The shadow ray runs from the offset origin to the light point itself, stopping just
 /// short of it, so the light never shadows itself. Twin of WGSL `occluded`.
+#[inline(always)]
 fn occluded(scene: &GpuScene, bvh: &WideBvh, p: Vec3, ng: Vec3, ls: &LightSample) -> bool {
     let origin = offset_origin(p, ng, ls.wi);
     if !ls.finite {
@@ -65,6 +68,7 @@ pub struct PathSample {
 
 /// Radiance along one camera path, its rays traced in `bvh` (built from `scene`). Twin of
 /// WGSL `trace_path`.
+#[inline(always)]
 pub fn trace_path(
     scene: &GpuScene,
     bvh: &WideBvh,
@@ -173,6 +177,7 @@ pub fn trace_path(
 
 /// A sample as it is accumulated: non-finite samples count as zero, channels are clamped to
 /// [0, SAMPLE_MAX]. Twin of the checks in WGSL `render` and `add_sample`.
+#[inline(always)]
 pub fn accumulated_value(radiance: Vec3) -> Vec3 {
     if radiance.is_finite() {
         radiance.clamp(Vec3::ZERO, Vec3::splat(SAMPLE_MAX))

@@ -45,6 +45,7 @@ const INVALID: LightSample = LightSample {
 
 /// Density of choosing the environment and direction `wi` from a point with normal `n`
 /// (on the side light is gathered from). Twin of WGSL `env_pdf`.
+#[inline(always)]
 pub fn env_pdf(params: &GpuFrameParams, n: Vec3, wi: Vec3) -> f32 {
     params.env_pmf * n.dot(wi).max(0.0) / PI
 }
@@ -65,6 +66,7 @@ fn sphere_cone(center: Vec3, radius: f32, p: Vec3) -> f32 {
 /// Density (solid angle, including the choice of the light) of sampling point `p_light`
 /// with normal `n_light` on light-table entry `(object, primitive)` from `p`. Twin of WGSL
 /// `light_pdf`.
+#[inline(always)]
 pub fn light_pdf(
     scene: &GpuScene,
     params: &GpuFrameParams,
@@ -181,6 +183,7 @@ fn sample_shape(
 
 /// Chooses a light and a point on it as seen from `p` with normal `n` (on the side light
 /// is gathered from). Twin of WGSL `sample_light`.
+#[inline(always)]
 pub fn sample_light(
     scene: &GpuScene,
     params: &GpuFrameParams,

@@ -83,6 +83,7 @@ pub struct Sampler {
 
 impl Sampler {
     /// Sample `index` of `pixel` under `seed`, of kind `SAMPLER_*`. Twin of WGSL `sampler_init`.
+    #[inline(always)]
     pub fn new(kind: u32, pixel: u32, index: u32, seed: u32) -> Self {
         Self {
             kind,
@@ -103,6 +104,7 @@ impl Sampler {
         to_unit_float((word >> 22) ^ word)
     }
 
+    #[inline(always)]
     fn dimension_seed(&mut self) -> u32 {
         let hash = match DIMENSION_HASHES.get(self.dimension as usize) {
             Some(&hash) => hash,
@@ -115,11 +117,13 @@ impl Sampler {
 
     /// The shuffled Sobol index of the dimension seeded `seed`: the sample index
     /// Owen-scrambled. Twin of WGSL `shuffled_index`.
+    #[inline(always)]
     fn shuffled_index(&self, seed: u32) -> u32 {
         owen_scramble_reversed(self.index_reversed, seed)
     }
 
     /// The next value in [0, 1). Twin of WGSL `next_1d`.
+    #[inline(always)]
     pub fn next_1d(&mut self) -> f32 {
         if self.kind != SAMPLER_SOBOL {
             return self.next_random();
@@ -132,6 +136,7 @@ impl Sampler {
 
     /// The next point in [0, 1)^2, stratified with the other samples of the pixel. Twin of
     /// WGSL `next_2d`.
+    #[inline(always)]
     pub fn next_2d(&mut self) -> Vec2 {
         if self.kind != SAMPLER_SOBOL {
             let x = self.next_random();

@@ -59,6 +59,7 @@ fn sample_texture(scene: &GpuScene, index: u32, uv: Vec2) -> Vec3 {
 }
 
 /// The material's colour at `uv`. Twin of WGSL `base_color`.
+#[inline(always)]
 pub fn base_color(scene: &GpuScene, material: &GpuMaterial, uv: Vec2) -> Vec3 {
     if material.texture >= 0 {
         sample_texture(scene, material.texture as u32, uv)
@@ -68,6 +69,7 @@ pub fn base_color(scene: &GpuScene, material: &GpuMaterial, uv: Vec2) -> Vec3 {
 }
 
 /// Twin of WGSL `surface_at`.
+#[inline(always)]
 pub fn surface_at(scene: &GpuScene, hit: &Hit, ray: &Ray) -> Surface {
     let o = &scene.objects[hit.object as usize];
     let [a, b, c] = [o.a, o.b, o.c].map(|v| Vec3::from_slice(&v));

@@ -10,7 +10,7 @@
 use std::path::{Path, PathBuf};
 
 use pathlight_core::{Film, GpuScene, load_scene_file};
-use pathlight_cpu::CpuRenderer;
+use pathlight_cpu::{CpuRenderer, InstructionSet};
 
 /// Mitsuba 3.9.1's own relMSE at 128x128, 64 spp, llvm_ad_rgb, mean over seeds 0-7, from
 /// `python tools/mitsuba_refs.py relmse NAME --res 128 --spp 64 --seeds 8`.
@@ -121,6 +121,38 @@ fn furnaces_are_exact() {
             (mean(&background) - 1.0).abs() <= 0.005,
             "{name}: background {}",
             mean(&background)
+        );
+    }
+}
+
+#[test]
+fn every_instruction_set_renders_the_same_image() {
+    // The path tracer is compiled once per instruction-set level; on this CPU every level
+    // it supports must give the baseline's image bit for bit (no level fuses operations).
+    let mut scene = load_scene_file(&refs().join("cornell-materials.toml")).unwrap();
+    scene.camera.width = 32;
+    scene.camera.height = 32;
+    let images: Vec<(InstructionSet, Film)> = InstructionSet::supported()
+        .into_iter()
+        .map(|isa| {
+            let mut renderer = CpuRenderer::new(&scene, GpuScene::build(&scene));
+            renderer.set_instruction_set(isa).unwrap();
+            while renderer.samples_done() < 4 {
+                renderer.advance(4 - renderer.samples_done());
+            }
+            (isa, renderer.film())
+        })
+        .collect();
+    let (_, baseline) = &images[0];
+    assert!(
+        baseline.mean().iter().all(|c| *c > 0.01),
+        "the image is black"
+    );
+    for (isa, film) in &images[1..] {
+        assert!(
+            film.pixels == baseline.pixels,
+            "{} differs from the baseline",
+            isa.name()
         );
     }
 }
