@@ -108,6 +108,7 @@ pub fn intersect_sphere(center: Vec3, radius: f32, ray: &Ray, t_max: f32) -> f32
 }
 
 /// Cylinder; twin of WGSL `intersect_cylinder`.
+#[inline(always)]
 pub fn intersect_cylinder(
     p0: Vec3,
     p1: Vec3,

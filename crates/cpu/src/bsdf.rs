@@ -75,6 +75,7 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
 
 /// Unpolarised conductor Fresnel reflectance for IOR eta + i k (Mitsuba 3's
 /// `fresnel_conductor`). Twin of WGSL `fresnel_conductor`.
+#[inline(always)]
 pub fn fresnel_conductor(cos_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
     let cos2 = cos_i * cos_i;
     let sin2 = 1.0 - cos2;
@@ -93,6 +94,7 @@ pub fn fresnel_conductor(cos_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
 }
 
 /// Reflectance of the specular lobe at `cos_i`. Twin of WGSL `specular_reflectance`.
+#[inline(always)]
 fn specular_reflectance(m: &GpuMaterial, color: Vec3, cos_i: f32) -> Vec3 {
     if m.conductor != 0 {
         return fresnel_conductor(cos_i, Vec3::from(m.eta), Vec3::from(m.k));
@@ -120,6 +122,7 @@ pub fn ggx_g1(w: Vec3, alpha: f32) -> f32 {
 
 /// A GGX normal visible from `wo` (flipped into the upper hemisphere), Heitz 2018.
 /// Twin of WGSL `ggx_sample_visible`.
+#[inline(always)]
 pub fn ggx_sample_visible(wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
     let w = if wo.z < 0.0 { -wo } else { wo };
     let vh = Vec3::new(alpha * w.x, alpha * w.y, w.z).normalize();
@@ -206,6 +209,7 @@ pub fn eval_bsdf(m: &GpuMaterial, color: Vec3, s: &Surface, wo: Vec3, wi: Vec3) 
 
 /// Rough dielectric (pbrt-v4 `DielectricBxDF::f` and `PDF`, separable Smith) in the frame
 /// of the outward shading normal. Twin of WGSL `eval_rough_dielectric`.
+#[inline(always)]
 fn eval_rough_dielectric(
     m: &GpuMaterial,
     color: Vec3,
@@ -268,6 +272,7 @@ fn eval_rough_dielectric(
 }
 
 /// `f / pdf` of the whole mixture at a sampled non-delta `wi`. Twin of WGSL `mixture_sample`.
+#[inline(always)]
 fn mixture_sample(m: &GpuMaterial, color: Vec3, s: &Surface, wo: Vec3, wi: Vec3) -> BsdfSample {
     let e = eval_bsdf(m, color, s, wo, wi);
     if e.pdf <= 0.0 || !e.pdf.is_finite() {
@@ -379,6 +384,7 @@ pub fn sample_bsdf(
 
 /// Smooth dielectric: reflect with probability F, else refract; radiance scaled by
 /// 1/eta^2 on refraction (as Mitsuba and pbrt do). Twin of WGSL `sample_smooth_dielectric`.
+#[inline(always)]
 fn sample_smooth_dielectric(
     m: &GpuMaterial,
     color: Vec3,

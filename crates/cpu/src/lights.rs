@@ -102,6 +102,7 @@ pub fn light_pdf(
 /// A point on entry `entry`'s shape: (point, normal, area density); spheres seen from
 /// outside return a cone sample and its solid-angle density as a negative value. Twin of
 /// WGSL `sample_shape`.
+#[inline(always)]
 fn sample_shape(
     scene: &GpuScene,
     o: &GpuObject,
