@@ -35,6 +35,19 @@ pub struct Hit {
     pub b2: f32,
 }
 
+impl Hit {
+    /// No hit yet: a search up to `t_max` (`object` is `u32::MAX` until something is hit).
+    pub fn none(t_max: f32) -> Self {
+        Self {
+            t: t_max,
+            object: u32::MAX,
+            primitive: 0,
+            b1: 0.0,
+            b2: 0.0,
+        }
+    }
+}
+
 /// Slab test; twin of WGSL `intersect_aabb`. Returns the entry distance or [`MISS`].
 ///
 /// In SIMD lanes (`Vec3A`): its min and max skip the NaN handling of `f32::min`, which cost a
@@ -262,13 +275,7 @@ impl GpuScene {
     /// Nearest hit in `(0, t_max)`, or with `any_hit` the first one found: one ordered
     /// stack walk over both levels. Twin of WGSL `trace_scene` (its BVH scheme).
     fn trace(&self, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
-        let mut hit = Hit {
-            t: t_max,
-            object: u32::MAX,
-            primitive: 0,
-            b1: 0.0,
-            b2: 0.0,
-        };
+        let mut hit = Hit::none(t_max);
         let nodes = &self.nodes;
         let inv_dir = safe_inverse(ray.dir);
         if self.object_count == 0 || intersect_aabb(&nodes[0], ray.origin, inv_dir, hit.t) == MISS {

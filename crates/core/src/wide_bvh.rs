@@ -193,13 +193,7 @@ impl WideBvh {
 
     #[inline(always)]
     fn trace(&self, scene: &GpuScene, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
-        let mut hit = Hit {
-            t: t_max,
-            object: u32::MAX,
-            primitive: 0,
-            b1: 0.0,
-            b2: 0.0,
-        };
+        let mut hit = Hit::none(t_max);
         if self.has_objects {
             let lanes = RayLanes::new(ray);
             STACK.with_borrow_mut(|stack| {

@@ -152,13 +152,7 @@ fn validate(gpu: &GpuScene) {
 
 /// The nearest hit over every object and every triangle, without the BVH.
 fn brute_force(gpu: &GpuScene, ray: &Ray, t_max: f32) -> Option<Hit> {
-    let mut hit = Hit {
-        t: t_max,
-        object: u32::MAX,
-        primitive: 0,
-        b1: 0.0,
-        b2: 0.0,
-    };
+    let mut hit = Hit::none(t_max);
     for (i, o) in gpu
         .objects
         .iter()
