@@ -8,7 +8,7 @@ use pathlight_core::{GpuScene, WideBvh};
 
 use crate::bsdf::{eval_bsdf, has_continuous_lobe, sample_bsdf};
 use crate::lights::{LightSample, env_pdf, light_pdf, sample_light};
-use crate::sampler::Sampler;
+use crate::sampler::{Draw, Sampler};
 use crate::sampling::power_heuristic;
 use crate::surface::{base_color, surface_at};
 
@@ -129,12 +129,16 @@ pub fn trace_path(
             break;
         }
         // Every bounce draws the same dimensions in the same order.
-        let u_light_select = sampler.next_1d();
-        let u_light = sampler.next_2d();
-        let u_lobe = sampler.next_1d();
-        let u_fresnel = sampler.next_1d();
-        let u_bsdf = sampler.next_2d();
-        let u_rr = sampler.next_1d();
+        let [u_light_select, u_light, u_lobe, u_fresnel, u_bsdf, u_rr] = sampler.next_batch([
+            Draw::One,
+            Draw::Two,
+            Draw::One,
+            Draw::One,
+            Draw::Two,
+            Draw::One,
+        ]);
+        let [u_light_select, u_lobe, u_fresnel, u_rr] =
+            [u_light_select, u_lobe, u_fresnel, u_rr].map(|u| u.x);
         let color = base_color(scene, material, s.uv);
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
         if has_continuous_lobe(material) {
