@@ -388,3 +388,25 @@ fn large_mesh_bvh_is_valid_and_exact() {
     let rays: Vec<Ray> = (0..300).map(|_| random_ray(&mut rng, 1.0)).collect();
     assert!(assert_same(&gpu, &rays) > 50);
 }
+
+#[test]
+fn coincident_triangles_build_and_trace() {
+    // 5,000 copies of one triangle: no centroid splits them, whatever depth the build makes.
+    let mut mesh = TriangleMesh::default();
+    for t in 0..5000u32 {
+        mesh.positions.extend([Vec3::new(-1.0, -1.0, 0.0), Vec3::X, Vec3::Y]);
+        mesh.normals.extend([Vec3::Z; 3]);
+        mesh.uvs.extend([Vec2::ZERO; 3]);
+        mesh.indices.push([3 * t, 3 * t + 1, 3 * t + 2]);
+    }
+    let objects = vec![Object {
+        name: "stack".into(),
+        material: 0,
+        shape: Shape::Mesh(mesh),
+    }];
+    let gpu = GpuScene::build(&scene_of(objects));
+    validate(&gpu);
+    let mut rng = StdRng::seed_from_u64(5);
+    let rays: Vec<Ray> = (0..200).map(|_| random_ray(&mut rng, 0.5)).collect();
+    assert!(assert_same(&gpu, &rays) > 20);
+}
