@@ -394,7 +394,8 @@ fn coincident_triangles_build_and_trace() {
     // 5,000 copies of one triangle: no centroid splits them, whatever depth the build makes.
     let mut mesh = TriangleMesh::default();
     for t in 0..5000u32 {
-        mesh.positions.extend([Vec3::new(-1.0, -1.0, 0.0), Vec3::X, Vec3::Y]);
+        mesh.positions
+            .extend([Vec3::new(-1.0, -1.0, 0.0), Vec3::X, Vec3::Y]);
         mesh.normals.extend([Vec3::Z; 3]);
         mesh.uvs.extend([Vec2::ZERO; 3]);
         mesh.indices.push([3 * t, 3 * t + 1, 3 * t + 2]);
