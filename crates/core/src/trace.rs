@@ -8,8 +8,6 @@ use crate::gpu::{FLAG_CAPS, GpuBvhNode, KIND_MESH, KIND_QUAD, KIND_SPHERE};
 
 /// Distance returned when there is no hit (WGSL `MISS`).
 pub const MISS: f32 = 3.0e38;
-/// Traversal stack depth (WGSL `STACK_SIZE`).
-const STACK_SIZE: usize = 64;
 
 /// A ray with a unit direction.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -281,8 +279,8 @@ impl GpuScene {
         if self.object_count == 0 || intersect_aabb(&nodes[0], ray.origin, inv_dir, hit.t) == MISS {
             return hit;
         }
-        let mut stack = [(Entry::Node(0), 0.0f32); STACK_SIZE];
-        let mut sp = 0;
+        // WGSL sizes its stack by `traversal_stack_bound`; here it grows as needed.
+        let mut stack: Vec<(Entry, f32)> = Vec::with_capacity(64);
         let mut index = 0u32;
         // The mesh whose BLAS is being walked, if any.
         let mut mesh: Option<u32> = None;
@@ -298,12 +296,11 @@ impl GpuScene {
                             let o = &self.objects[i as usize];
                             if o.kind != KIND_MESH {
                                 self.intersect_shape(i, ray, &mut hit);
-                            } else if sp < STACK_SIZE {
+                            } else {
                                 let root = &nodes[o.blas_root as usize];
                                 let t = intersect_aabb(root, ray.origin, inv_dir, hit.t);
                                 if t != MISS {
-                                    stack[sp] = (Entry::EnterMesh(i), t);
-                                    sp += 1;
+                                    stack.push((Entry::EnterMesh(i), t));
                                 }
                             }
                         }
@@ -319,10 +316,7 @@ impl GpuScene {
                 if ta != MISS && tb != MISS {
                     let (near, far) = if ta <= tb { (a, a + 1) } else { (a + 1, a) };
                     index = near;
-                    if sp < STACK_SIZE {
-                        stack[sp] = (Entry::Node(far), ta.max(tb));
-                        sp += 1;
-                    }
+                    stack.push((Entry::Node(far), ta.max(tb)));
                     descend = true;
                 } else if ta != MISS || tb != MISS {
                     index = if ta != MISS { a } else { a + 1 };
@@ -331,17 +325,14 @@ impl GpuScene {
             }
             if !descend {
                 let mut found = false;
-                while sp > 0 {
-                    sp -= 1;
-                    let (entry, t) = stack[sp];
+                while let Some((entry, t)) = stack.pop() {
                     match entry {
                         Entry::LeaveMesh => mesh = None,
                         _ if t >= hit.t => {}
                         Entry::EnterMesh(object) => {
                             mesh = Some(object);
                             index = self.objects[object as usize].blas_root;
-                            stack[sp] = (Entry::LeaveMesh, 0.0);
-                            sp += 1;
+                            stack.push((Entry::LeaveMesh, 0.0));
                             found = true;
                             break;
                         }
