@@ -10,6 +10,7 @@ use std::cell::RefCell;
 use std::ops::Range;
 
 use glam::{Vec3, Vec4};
+use obvhs::aabb::Aabb;
 
 use crate::accel::GpuScene;
 use crate::gpu::{GpuBvhNode, KIND_MESH};
@@ -216,8 +217,7 @@ impl WideBvh {
 
 /// Half the surface area of a binary node's box.
 fn half_area(node: &GpuBvhNode) -> f32 {
-    let d = Vec3::from(node.aabb_max) - Vec3::from(node.aabb_min);
-    d.x * d.y + d.y * d.z + d.z * d.x
+    Aabb::new(node.aabb_min.into(), node.aabb_max.into()).half_area()
 }
 
 /// One ray query in progress.

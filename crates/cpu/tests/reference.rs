@@ -129,6 +129,8 @@ fn furnaces_are_exact() {
 fn every_instruction_set_renders_the_same_image() {
     // The path tracer is compiled once per instruction-set level; on this CPU every level
     // it supports must give the baseline's image bit for bit (no level fuses operations).
+    // (A CPU with the baseline alone has nothing to compare; the project's machine has all
+    // three levels.)
     let mut scene = load_scene_file(&refs().join("cornell-materials.toml")).unwrap();
     scene.camera.width = 32;
     scene.camera.height = 32;
