@@ -21,4 +21,4 @@ pub use error::SceneError;
 pub use film::Film;
 pub use load::{SceneSource, load_scene, load_scene_file};
 pub use scene::{Camera, Material, Object, RenderSettings, Scene, Shape};
-pub use wide_bvh::WideBvh;
+pub use wide_bvh::{Tracer, WideBvh};

@@ -6,7 +6,6 @@
 //! only the order of the walk differs (which can change the answer between two primitives at
 //! exactly the same distance).
 
-use std::cell::RefCell;
 use std::ops::Range;
 
 use glam::{Vec3, Vec4};
@@ -49,11 +48,6 @@ pub struct WideBvh {
 struct Entry {
     node: u32,
     t: f32,
-}
-
-thread_local! {
-    /// Each thread's traversal stack, reused so that a ray query allocates nothing.
-    static STACK: RefCell<Vec<Entry>> = const { RefCell::new(Vec::new()) };
 }
 
 /// The ray in the form the box tests want: its origin and inverse direction splatted across
@@ -178,37 +172,59 @@ impl WideBvh {
         }
         index
     }
+}
+
+/// Ray queries from one thread against a scene and its [`WideBvh`]. It keeps the traversal
+/// stack that every query reuses, so that queries allocate nothing once it has grown to the
+/// tree's needs, and so that the whole walk inlines into the caller (compiled for its
+/// instruction set).
+#[derive(Debug, Clone)]
+pub struct Tracer<'a> {
+    /// The scene.
+    pub scene: &'a GpuScene,
+    /// Its tree.
+    pub bvh: &'a WideBvh,
+    stack: Vec<Entry>,
+}
+
+impl<'a> Tracer<'a> {
+    /// Queries against `scene` in `bvh`, which must have been built from it.
+    pub fn new(scene: &'a GpuScene, bvh: &'a WideBvh) -> Self {
+        Self {
+            scene,
+            bvh,
+            stack: Vec::new(),
+        }
+    }
 
     /// Nearest hit in `(0, t_max)`.
     #[inline(always)]
-    pub fn intersect(&self, scene: &GpuScene, ray: &Ray, t_max: f32) -> Option<Hit> {
-        let hit = self.trace(scene, ray, t_max, false);
+    pub fn intersect(&mut self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let hit = self.trace(ray, t_max, false);
         (hit.object != u32::MAX).then_some(hit)
     }
 
     /// Whether anything lies on the ray in `(0, t_max)`.
     #[inline(always)]
-    pub fn occluded(&self, scene: &GpuScene, ray: &Ray, t_max: f32) -> bool {
-        self.trace(scene, ray, t_max, true).object != u32::MAX
+    pub fn occluded(&mut self, ray: &Ray, t_max: f32) -> bool {
+        self.trace(ray, t_max, true).object != u32::MAX
     }
 
     #[inline(always)]
-    fn trace(&self, scene: &GpuScene, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
+    fn trace(&mut self, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
         let mut hit = Hit::none(t_max);
-        if self.has_objects {
+        if self.bvh.has_objects {
             let lanes = RayLanes::new(ray);
-            STACK.with_borrow_mut(|stack| {
-                stack.clear();
-                let walk = Walk {
-                    bvh: self,
-                    scene,
-                    ray,
-                    lanes: &lanes,
-                    any_hit,
-                };
-                walk.tree(stack, 0, &mut hit, |stack, range, hit| {
-                    walk.objects(stack, range, hit)
-                });
+            self.stack.clear();
+            let walk = Walk {
+                bvh: self.bvh,
+                scene: self.scene,
+                ray,
+                lanes: &lanes,
+                any_hit,
+            };
+            walk.tree(&mut self.stack, 0, &mut hit, |stack, range, hit| {
+                walk.objects(stack, range, hit)
             });
         }
         hit
@@ -233,7 +249,7 @@ impl Walk<'_> {
     /// Walks the tree at `root`, nearest boxes first, using `stack` above its current
     /// length. Leaves go to `leaf` as their node is visited (nearest first); inner nodes are
     /// pushed. Returns false as soon as `leaf` does (an any-hit query has its answer).
-    #[inline]
+    #[inline(always)]
     fn tree(
         &self,
         stack: &mut Vec<Entry>,
@@ -294,7 +310,7 @@ impl Walk<'_> {
 
     /// Tests the top-level objects `range`, walking the tree of each mesh among them.
     /// Returns false once an any-hit query has its answer.
-    #[inline]
+    #[inline(always)]
     fn objects(&self, stack: &mut Vec<Entry>, range: Range<u32>, hit: &mut Hit) -> bool {
         for i in range {
             if self.scene.objects[i as usize].kind == KIND_MESH {
@@ -314,7 +330,7 @@ impl Walk<'_> {
 
     /// Tests the triangles `range` of mesh object `object`. Returns false once an any-hit
     /// query has its answer.
-    #[inline]
+    #[inline(always)]
     fn triangles(&self, object: u32, range: Range<u32>, hit: &mut Hit) -> bool {
         for tri in range {
             let [v0, e1, e2] = self.bvh.triangles[tri as usize];

@@ -6,7 +6,9 @@ use glam::{Vec2, Vec3};
 use pathlight_core::gpu::{GpuBvhNode, KIND_MESH};
 use pathlight_core::scene::{Camera, Lobes, Material, RenderSettings, TriangleMesh};
 use pathlight_core::trace::{Hit, Ray, intersect_triangle};
-use pathlight_core::{GpuScene, Object, Scene, Shape, WideBvh};
+use std::cell::RefCell;
+
+use pathlight_core::{GpuScene, Object, Scene, Shape, Tracer, WideBvh};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
@@ -217,13 +219,16 @@ type Traversal<'a> = (
 /// Checks both traversals against brute force on `rays`; returns how many rays hit.
 fn assert_same(gpu: &GpuScene, rays: &[Ray]) -> usize {
     let wide = WideBvh::build(gpu);
+    let tracer = RefCell::new(Tracer::new(gpu, &wide));
     let traversals: [Traversal; 2] = [
         ("twin", &|r, t| gpu.intersect(r, t), &|r, t| {
             gpu.occluded(r, t)
         }),
-        ("wide", &|r, t| wide.intersect(gpu, r, t), &|r, t| {
-            wide.occluded(gpu, r, t)
-        }),
+        (
+            "wide",
+            &|r, t| tracer.borrow_mut().intersect(r, t),
+            &|r, t| tracer.borrow_mut().occluded(r, t),
+        ),
     ];
     let mut hits = 0;
     for ray in rays {
@@ -296,11 +301,12 @@ fn empty_scene_has_no_hits() {
     assert_eq!(gpu.object_count, 0);
     let mut rng = StdRng::seed_from_u64(1);
     let wide = WideBvh::build(&gpu);
+    let mut tracer = Tracer::new(&gpu, &wide);
     for _ in 0..100 {
         let ray = random_ray(&mut rng, 3.0);
         assert_eq!(gpu.intersect(&ray, 1e30), None);
-        assert_eq!(wide.intersect(&gpu, &ray, 1e30), None);
-        assert!(!wide.occluded(&gpu, &ray, 1e30));
+        assert_eq!(tracer.intersect(&ray, 1e30), None);
+        assert!(!tracer.occluded(&ray, 1e30));
     }
 }
 

@@ -2,9 +2,9 @@
 //! `integrator.wgsl` (same loop, same order of sample dimensions).
 
 use glam::Vec3;
+use pathlight_core::Tracer;
 use pathlight_core::gpu::{GpuFrameParams, NO_LIGHT};
 use pathlight_core::trace::Ray;
-use pathlight_core::{GpuScene, WideBvh};
 
 use crate::bsdf::{eval_bsdf, has_continuous_lobe, sample_bsdf};
 use crate::lights::{LightSample, env_pdf, light_pdf, sample_light};
@@ -43,10 +43,10 @@ pub fn camera_ray(params: &GpuFrameParams, x: u32, y: u32, sampler: &mut Sampler
 /// The shadow ray runs from the offset origin to the light point itself, stopping just
 /// short of it, so the light never shadows itself. Twin of WGSL `occluded`.
 #[inline(always)]
-fn occluded(scene: &GpuScene, bvh: &WideBvh, p: Vec3, ng: Vec3, ls: &LightSample) -> bool {
+fn occluded(tracer: &mut Tracer, p: Vec3, ng: Vec3, ls: &LightSample) -> bool {
     let origin = offset_origin(p, ng, ls.wi);
     if !ls.finite {
-        return bvh.occluded(scene, &Ray { origin, dir: ls.wi }, T_MAX);
+        return tracer.occluded(&Ray { origin, dir: ls.wi }, T_MAX);
     }
     let to_light = ls.point - origin;
     let distance = to_light.length();
@@ -54,7 +54,7 @@ fn occluded(scene: &GpuScene, bvh: &WideBvh, p: Vec3, ng: Vec3, ls: &LightSample
         origin,
         dir: to_light / distance,
     };
-    bvh.occluded(scene, &ray, distance * (1.0 - 1e-4))
+    tracer.occluded(&ray, distance * (1.0 - 1e-4))
 }
 
 /// What one camera path brought back.
@@ -66,12 +66,10 @@ pub struct PathSample {
     pub rays: u32,
 }
 
-/// Radiance along one camera path, its rays traced in `bvh` (built from `scene`). Twin of
-/// WGSL `trace_path`.
+/// Radiance along one camera path, its rays traced by `tracer`. Twin of WGSL `trace_path`.
 #[inline(always)]
 pub fn trace_path(
-    scene: &GpuScene,
-    bvh: &WideBvh,
+    tracer: &mut Tracer,
     params: &GpuFrameParams,
     first: Ray,
     sampler: &mut Sampler,
@@ -91,10 +89,11 @@ pub fn trace_path(
     // Product of the relative IORs crossed: throughput * eta_scale^2 is the throughput
     // without the 1/eta^2 radiance scaling, which Russian roulette should see.
     let mut eta_scale = 1.0f32;
+    let scene = tracer.scene;
     let environment = Vec3::from(params.environment);
     for depth in 1..=params.max_depth {
         rays += 1;
-        let Some(hit) = bvh.intersect(scene, &ray, T_MAX) else {
+        let Some(hit) = tracer.intersect(&ray, T_MAX) else {
             let w = if prev_delta {
                 1.0
             } else {
@@ -147,7 +146,7 @@ pub fn trace_path(
                 let e = eval_bsdf(material, color, &s, wo, ls.wi);
                 if e.f.max_element() > 0.0 {
                     rays += 1;
-                    if !occluded(scene, bvh, s.position, s.ng, &ls) {
+                    if !occluded(tracer, s.position, s.ng, &ls) {
                         radiance += throughput * e.f * ls.radiance * power_heuristic(ls.pdf, e.pdf)
                             / ls.pdf;
                     }

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 use pathlight_core::frame::frame_params;
 use pathlight_core::gpu::GpuFrameParams;
-use pathlight_core::{Film, GpuScene, Scene, WideBvh};
+use pathlight_core::{Film, GpuScene, Scene, Tracer, WideBvh};
 use rayon::prelude::*;
 
 pub use crate::row::InstructionSet;
@@ -94,16 +94,17 @@ impl CpuRenderer {
             .sums
             .par_chunks_mut(width)
             .enumerate()
-            .map(|(y, row)| {
-                let job = RowJob {
-                    scene,
-                    bvh,
-                    params,
-                    y: y as u32,
-                    samples: offset..offset + samples,
-                };
-                render_row_with(isa, &job, row)
-            })
+            .map_init(
+                || Tracer::new(scene, bvh),
+                |tracer, (y, row)| {
+                    let job = RowJob {
+                        params,
+                        y: y as u32,
+                        samples: offset..offset + samples,
+                    };
+                    render_row_with(isa, tracer, &job, row)
+                },
+            )
             .sum();
         self.rays_traced += rays;
         self.samples_done += samples;

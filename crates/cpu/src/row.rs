@@ -3,16 +3,14 @@
 
 use std::ops::Range;
 
+use pathlight_core::Tracer;
 use pathlight_core::gpu::GpuFrameParams;
-use pathlight_core::{GpuScene, WideBvh};
 
 use crate::integrator::{accumulated_value, camera_ray, trace_path};
 use crate::sampler::Sampler;
 
 /// One row's share of an `advance`.
 pub(crate) struct RowJob<'a> {
-    pub scene: &'a GpuScene,
-    pub bvh: &'a WideBvh,
     pub params: &'a GpuFrameParams,
     /// The row.
     pub y: u32,
@@ -23,7 +21,7 @@ pub(crate) struct RowJob<'a> {
 /// Adds the samples of `job` to its row's sums; returns the rays traced. The whole path
 /// tracer is inlined here, so that each [`InstructionSet`] level compiles all of it.
 #[inline(always)]
-fn render_row(job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
+fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
     let params = job.params;
     let mut rays = 0;
     for (x, sum) in row.iter_mut().enumerate() {
@@ -31,7 +29,7 @@ fn render_row(job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
         for i in job.samples.clone() {
             let mut sampler = Sampler::new(params.sampler, pixel, i, params.seed);
             let ray = camera_ray(params, x as u32, job.y, &mut sampler);
-            let path = trace_path(job.scene, job.bvh, params, ray, &mut sampler);
+            let path = trace_path(tracer, params, ray, &mut sampler);
             rays += u64::from(path.rays);
             let value = accumulated_value(path.radiance);
             for c in 0..3 {
@@ -98,23 +96,28 @@ impl InstructionSet {
 }
 
 /// [`render_row`] compiled for `isa`, which the CPU must support.
-pub(crate) fn render_row_with(isa: InstructionSet, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
+pub(crate) fn render_row_with(
+    isa: InstructionSet,
+    tracer: &mut Tracer,
+    job: &RowJob,
+    row: &mut [[f64; 3]],
+) -> u64 {
     match isa {
-        InstructionSet::Baseline => render_row(job, row),
+        InstructionSet::Baseline => render_row(tracer, job, row),
         // SAFETY: `InstructionSet::supported` found the features on this CPU.
         #[cfg(target_arch = "x86_64")]
-        InstructionSet::X86_64V3 => unsafe { render_row_x86_64_v3(job, row) },
+        InstructionSet::X86_64V3 => unsafe { render_row_x86_64_v3(tracer, job, row) },
         // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
-        InstructionSet::X86_64V4Gfni => unsafe { render_row_x86_64_v4_gfni(job, row) },
+        InstructionSet::X86_64V4Gfni => unsafe { render_row_x86_64_v4_gfni(tracer, job, row) },
     }
 }
 
 /// [`render_row`] for x86-64-v3.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe")]
-fn render_row_x86_64_v3(job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
-    render_row(job, row)
+fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
+    render_row(tracer, job, row)
 }
 
 /// [`render_row`] for x86-64-v4 with GFNI.
@@ -122,6 +125,6 @@ fn render_row_x86_64_v3(job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
 #[target_feature(
     enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe,avx512f,avx512vl,avx512bw,avx512dq,avx512cd,gfni"
 )]
-fn render_row_x86_64_v4_gfni(job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
-    render_row(job, row)
+fn render_row_x86_64_v4_gfni(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
+    render_row(tracer, job, row)
 }

@@ -100,13 +100,14 @@ fn extreme_values_give_finite_samples_on_both_backends() {
     let gpu_scene = GpuScene::build(&s);
     let params = pathlight_core::frame::frame_params(&s, &gpu_scene);
     let bvh = pathlight_core::WideBvh::build(&gpu_scene);
+    let mut tracer = pathlight_core::Tracer::new(&gpu_scene, &bvh);
     let mut nonzero = 0;
     for y in 0..32 {
         for x in 0..32 {
             for i in 0..16 {
                 let mut sampler = Sampler::new(params.sampler, y * 32 + x, i, params.seed);
                 let ray = camera_ray(&params, x, y, &mut sampler);
-                let l = trace_path(&gpu_scene, &bvh, &params, ray, &mut sampler).radiance;
+                let l = trace_path(&mut tracer, &params, ray, &mut sampler).radiance;
                 assert!(
                     l.is_finite() && l.min_element() >= 0.0,
                     "pixel ({x}, {y}) sample {i}: {l}"
