@@ -10,6 +10,7 @@ pub mod frame;
 pub mod gpu;
 pub mod load;
 pub mod mesh;
+pub mod packet;
 pub mod revolve;
 pub mod scene;
 pub mod texture;

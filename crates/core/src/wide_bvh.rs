@@ -17,42 +17,42 @@ use crate::trace::{Hit, Ray, intersect_triangle_edges, safe_inverse};
 
 /// Four child boxes in structure-of-arrays form, and what each child is.
 #[derive(Debug, Clone, Copy)]
-struct Node4 {
+pub(crate) struct Node4 {
     /// Per axis x, y, z: the children's minimum coordinates. An unused lane holds an
     /// inverted box (+inf to -inf) that no ray enters.
-    lo: [Vec4; 3],
+    pub lo: [Vec4; 3],
     /// Per axis: the children's maximum coordinates.
-    hi: [Vec4; 3],
+    pub hi: [Vec4; 3],
     /// Per child: the index of an inner node, or a leaf's first primitive.
-    first: [u32; 4],
+    pub first: [u32; 4],
     /// Per child: the number of primitives of a leaf; 0 for an inner node or an unused lane.
-    count: [u32; 4],
+    pub count: [u32; 4],
 }
 
 /// A 4-wide BVH over a [`GpuScene`]: one tree over the objects and one per mesh.
 #[derive(Debug, Clone, Default)]
 pub struct WideBvh {
     /// Every tree's nodes; the top level's root is node 0 (when there are objects).
-    nodes: Vec<Node4>,
+    pub(crate) nodes: Vec<Node4>,
     /// Per object of the scene: the root of its mesh's tree (unused for other shapes).
-    mesh_roots: Vec<u32>,
+    pub(crate) mesh_roots: Vec<u32>,
     /// Per triangle: its first corner and the two edges from it (`intersect_triangle`'s
     /// subtractions done once, with the same results).
-    triangles: Vec<[Vec3; 3]>,
+    pub(crate) triangles: Vec<[Vec3; 3]>,
     /// Whether the scene has any object.
-    has_objects: bool,
+    pub(crate) has_objects: bool,
 }
 
 /// A node still to visit, and the distance at which the ray enters its box.
 #[derive(Debug, Clone, Copy)]
-struct Entry {
+pub(crate) struct Entry {
     node: u32,
     t: f32,
 }
 
 /// The ray in the form the box tests want: its origin and inverse direction splatted across
 /// lanes, and per axis whether it runs backwards (so the maximum planes are the near ones).
-struct RayLanes {
+pub(crate) struct RayLanes {
     origin: [Vec4; 3],
     inv_dir: [Vec4; 3],
     backwards: [bool; 3],
@@ -60,7 +60,7 @@ struct RayLanes {
 
 impl RayLanes {
     #[inline(always)]
-    fn new(ray: &Ray) -> Self {
+    pub(crate) fn new(ray: &Ray) -> Self {
         let inv = safe_inverse(ray.dir);
         Self {
             origin: [
@@ -184,7 +184,10 @@ pub struct Tracer<'a> {
     pub scene: &'a GpuScene,
     /// Its tree.
     pub bvh: &'a WideBvh,
-    stack: Vec<Entry>,
+    /// The single-ray walk's stack.
+    pub(crate) stack: Vec<Entry>,
+    /// The packet walk's stack: nodes and the rays that entered them.
+    pub(crate) packet_stack: Vec<(u32, u32)>,
 }
 
 impl<'a> Tracer<'a> {
@@ -194,6 +197,7 @@ impl<'a> Tracer<'a> {
             scene,
             bvh,
             stack: Vec::new(),
+            packet_stack: Vec::new(),
         }
     }
 
@@ -237,12 +241,12 @@ fn half_area(node: &GpuBvhNode) -> f32 {
 }
 
 /// One ray query in progress.
-struct Walk<'a> {
-    bvh: &'a WideBvh,
-    scene: &'a GpuScene,
-    ray: &'a Ray,
-    lanes: &'a RayLanes,
-    any_hit: bool,
+pub(crate) struct Walk<'a> {
+    pub bvh: &'a WideBvh,
+    pub scene: &'a GpuScene,
+    pub ray: &'a Ray,
+    pub lanes: &'a RayLanes,
+    pub any_hit: bool,
 }
 
 impl Walk<'_> {
@@ -250,7 +254,7 @@ impl Walk<'_> {
     /// length. Leaves go to `leaf` as their node is visited (nearest first); inner nodes are
     /// pushed. Returns false as soon as `leaf` does (an any-hit query has its answer).
     #[inline(always)]
-    fn tree(
+    pub(crate) fn tree(
         &self,
         stack: &mut Vec<Entry>,
         root: u32,
@@ -311,7 +315,7 @@ impl Walk<'_> {
     /// Tests the top-level objects `range`, walking the tree of each mesh among them.
     /// Returns false once an any-hit query has its answer.
     #[inline(always)]
-    fn objects(&self, stack: &mut Vec<Entry>, range: Range<u32>, hit: &mut Hit) -> bool {
+    pub(crate) fn objects(&self, stack: &mut Vec<Entry>, range: Range<u32>, hit: &mut Hit) -> bool {
         for i in range {
             if self.scene.objects[i as usize].kind == KIND_MESH {
                 let root = self.bvh.mesh_roots[i as usize];
@@ -331,7 +335,7 @@ impl Walk<'_> {
     /// Tests the triangles `range` of mesh object `object`. Returns false once an any-hit
     /// query has its answer.
     #[inline(always)]
-    fn triangles(&self, object: u32, range: Range<u32>, hit: &mut Hit) -> bool {
+    pub(crate) fn triangles(&self, object: u32, range: Range<u32>, hit: &mut Hit) -> bool {
         for tri in range {
             let [v0, e1, e2] = self.bvh.triangles[tri as usize];
             let (t, b1, b2) = intersect_triangle_edges(v0, e1, e2, self.ray, hit.t);

@@ -4,6 +4,7 @@
 
 use glam::{Vec2, Vec3};
 use pathlight_core::gpu::{GpuBvhNode, KIND_MESH};
+use pathlight_core::packet::{PACKET, RayPacket};
 use pathlight_core::scene::{Camera, Lobes, Material, RenderSettings, TriangleMesh};
 use pathlight_core::trace::{Hit, Ray, intersect_triangle};
 use std::cell::RefCell;
@@ -216,11 +217,30 @@ type Traversal<'a> = (
     &'a dyn Fn(&Ray, f32) -> bool,
 );
 
-/// Checks both traversals against brute force on `rays`; returns how many rays hit.
+/// Checks the traversals (the twin, the wide BVH alone and in packets) against brute force on `rays`; returns how many rays hit.
 fn assert_same(gpu: &GpuScene, rays: &[Ray]) -> usize {
     let wide = WideBvh::build(gpu);
     let tracer = RefCell::new(Tracer::new(gpu, &wide));
-    let traversals: [Traversal; 2] = [
+    // The ray in a packet with others of `rays` (a lane left out here and there), at a lane
+    // that depends on the ray.
+    let packet_of = |ray: &Ray, t_max: f32| {
+        let start = ray.origin.x.to_bits() as usize % rays.len();
+        let lane = start % PACKET;
+        let mut packet = RayPacket {
+            t_max: [t_max; PACKET],
+            active: 0x7fbf | (1 << lane),
+            ..RayPacket::default()
+        };
+        for (l, r) in packet.rays.iter_mut().enumerate() {
+            *r = if l == lane {
+                *ray
+            } else {
+                rays[(start + l) % rays.len()]
+            };
+        }
+        (packet, lane)
+    };
+    let traversals: [Traversal; 3] = [
         ("twin", &|r, t| gpu.intersect(r, t), &|r, t| {
             gpu.occluded(r, t)
         }),
@@ -228,6 +248,17 @@ fn assert_same(gpu: &GpuScene, rays: &[Ray]) -> usize {
             "wide",
             &|r, t| tracer.borrow_mut().intersect(r, t),
             &|r, t| tracer.borrow_mut().occluded(r, t),
+        ),
+        (
+            "packet",
+            &|r, t| {
+                let (packet, lane) = packet_of(r, t);
+                tracer.borrow_mut().intersect_packet(&packet)[lane]
+            },
+            &|r, t| {
+                let (packet, lane) = packet_of(r, t);
+                tracer.borrow_mut().occluded_packet(&packet) >> lane & 1 != 0
+            },
         ),
     ];
     let mut hits = 0;

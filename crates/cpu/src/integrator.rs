@@ -2,9 +2,9 @@
 //! `integrator.wgsl` (same loop, same order of sample dimensions).
 
 use glam::Vec3;
-use pathlight_core::Tracer;
 use pathlight_core::gpu::{GpuFrameParams, NO_LIGHT};
-use pathlight_core::trace::Ray;
+use pathlight_core::trace::{Hit, Ray};
+use pathlight_core::{GpuScene, Tracer};
 
 use crate::bsdf::{eval_bsdf, has_continuous_lobe, sample_bsdf};
 use crate::lights::{LightSample, env_pdf, light_pdf, sample_light};
@@ -14,7 +14,8 @@ use crate::surface::{base_color, surface_at};
 
 /// Largest radiance one sample may add per channel (WGSL `SAMPLE_MAX`).
 pub const SAMPLE_MAX: f32 = 16_777_216.0;
-const T_MAX: f32 = 1.0e30;
+/// End of the interval searched by extension rays.
+pub const T_MAX: f32 = 1.0e30;
 
 /// Start of a ray leaving `p` on the side of `ng` that `dir` points to. Twin of WGSL
 /// `offset_origin`.
@@ -26,7 +27,7 @@ fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
 
 /// Camera ray through a jittered point of pixel (x, y). Twin of WGSL `camera_ray`.
 #[inline(always)]
-pub fn camera_ray(params: &GpuFrameParams, x: u32, y: u32, sampler: &mut Sampler) -> Ray {
+fn camera_ray(params: &GpuFrameParams, x: u32, y: u32, sampler: &mut Sampler) -> Ray {
     let jitter = sampler.next_2d();
     let ndc_x = 2.0 * (x as f32 + jitter.x) / params.width as f32 - 1.0;
     let ndc_y = 1.0 - 2.0 * (y as f32 + jitter.y) / params.height as f32;
@@ -39,14 +40,15 @@ pub fn camera_ray(params: &GpuFrameParams, x: u32, y: u32, sampler: &mut Sampler
     }
 }
 
-/// Whether anything blocks the light sample `ls` from surface point `p` (normal `ng`).
-/// The shadow ray runs from the offset origin to the light point itself, stopping just
-/// short of it, so the light never shadows itself. Twin of WGSL `occluded`.
+/// The shadow ray testing whether anything blocks the light sample `ls` from surface point
+/// `p` (normal `ng`), and the end of its interval. It runs from the offset origin to the
+/// light point itself, stopping just short of it, so the light never shadows itself. Twin of
+/// WGSL `occluded`.
 #[inline(always)]
-fn occluded(tracer: &mut Tracer, p: Vec3, ng: Vec3, ls: &LightSample) -> bool {
+fn shadow_ray(p: Vec3, ng: Vec3, ls: &LightSample) -> (Ray, f32) {
     let origin = offset_origin(p, ng, ls.wi);
     if !ls.finite {
-        return tracer.occluded(&Ray { origin, dir: ls.wi }, T_MAX);
+        return (Ray { origin, dir: ls.wi }, T_MAX);
     }
     let to_light = ls.point - origin;
     let distance = to_light.length();
@@ -54,7 +56,7 @@ fn occluded(tracer: &mut Tracer, p: Vec3, ng: Vec3, ls: &LightSample) -> bool {
         origin,
         dir: to_light / distance,
     };
-    tracer.occluded(&ray, distance * (1.0 - 1e-4))
+    (ray, distance * (1.0 - 1e-4))
 }
 
 /// What one camera path brought back.
@@ -66,41 +68,88 @@ pub struct PathSample {
     pub rays: u32,
 }
 
-/// Radiance along one camera path, its rays traced by `tracer`. Twin of WGSL `trace_path`.
-#[inline(always)]
-pub fn trace_path(
-    tracer: &mut Tracer,
-    params: &GpuFrameParams,
-    first: Ray,
-    sampler: &mut Sampler,
-) -> PathSample {
-    let mut rays = 0;
-    let mut ray = first;
-    let mut radiance = Vec3::ZERO;
-    let mut throughput = Vec3::ONE;
-    // Density of the BSDF sample that produced `ray`, and whether it came from a delta lobe
-    // (camera rays count as delta: emitters they see get full weight).
-    let mut prev_pdf = 0.0f32;
-    let mut prev_delta = true;
-    let mut prev_position = ray.origin;
-    // Normal (on the side of wo) at the vertex that produced `ray`: environment sampling
-    // there was cosine-weighted about it.
-    let mut prev_normal = Vec3::ZERO;
-    // Product of the relative IORs crossed: throughput * eta_scale^2 is the throughput
-    // without the 1/eta^2 radiance scaling, which Russian roulette should see.
-    let mut eta_scale = 1.0f32;
-    let scene = tracer.scene;
-    let environment = Vec3::from(params.environment);
-    for depth in 1..=params.max_depth {
-        rays += 1;
-        let Some(hit) = tracer.intersect(&ray, T_MAX) else {
-            let w = if prev_delta {
+/// A light sample's shadow ray, and the radiance it adds unless something blocks it.
+#[derive(Debug, Clone, Copy)]
+pub struct ShadowTest {
+    /// The shadow ray.
+    pub ray: Ray,
+    /// The end of its interval.
+    pub t_max: f32,
+    /// Radiance added to the path when nothing blocks the ray.
+    pub radiance: Vec3,
+}
+
+/// One camera path in progress, between its ray queries: [`Path::ray`] is to be traced and
+/// its nearest hit given to [`Path::step`]. Twin of the state of WGSL `trace_path`'s loop.
+#[derive(Debug, Clone)]
+pub struct Path {
+    /// The next ray to trace.
+    pub ray: Ray,
+    /// False once the path has ended.
+    pub alive: bool,
+    /// What it has brought back so far.
+    pub sample: PathSample,
+    sampler: Sampler,
+    depth: u32,
+    throughput: Vec3,
+    /// Density of the BSDF sample that produced `ray`, and whether it came from a delta
+    /// lobe (camera rays count as delta: emitters they see get full weight).
+    prev_pdf: f32,
+    prev_delta: bool,
+    prev_position: Vec3,
+    /// Normal (on the side of wo) at the vertex that produced `ray`: environment sampling
+    /// there was cosine-weighted about it.
+    prev_normal: Vec3,
+    /// Product of the relative IORs crossed: throughput * eta_scale^2 is the throughput
+    /// without the 1/eta^2 radiance scaling, which Russian roulette should see.
+    eta_scale: f32,
+}
+
+impl Path {
+    /// The path of sample `sampler` through pixel (x, y): its camera ray.
+    #[inline(always)]
+    pub fn new(params: &GpuFrameParams, x: u32, y: u32, mut sampler: Sampler) -> Self {
+        let ray = camera_ray(params, x, y, &mut sampler);
+        Self {
+            ray,
+            alive: params.max_depth > 0,
+            sample: PathSample {
+                radiance: Vec3::ZERO,
+                rays: 0,
+            },
+            sampler,
+            depth: 0,
+            throughput: Vec3::ONE,
+            prev_pdf: 0.0,
+            prev_delta: true,
+            prev_position: ray.origin,
+            prev_normal: Vec3::ZERO,
+            eta_scale: 1.0,
+        }
+    }
+
+    /// Goes on from `hit`, the nearest hit of [`Path::ray`]: adds what the path sees there,
+    /// samples a light (returning its shadow ray, for the caller to trace and
+    /// [`Path::add_unblocked`]) and the BSDF (the next ray), or ends the path.
+    #[inline(always)]
+    pub fn step(
+        &mut self,
+        scene: &GpuScene,
+        params: &GpuFrameParams,
+        hit: Option<Hit>,
+    ) -> Option<ShadowTest> {
+        self.depth += 1;
+        self.sample.rays += 1;
+        let ray = self.ray;
+        let Some(hit) = hit else {
+            let w = if self.prev_delta {
                 1.0
             } else {
-                power_heuristic(prev_pdf, env_pdf(params, prev_normal, ray.dir))
+                power_heuristic(self.prev_pdf, env_pdf(params, self.prev_normal, ray.dir))
             };
-            radiance += throughput * environment * w;
-            break;
+            self.sample.radiance += self.throughput * Vec3::from(params.environment) * w;
+            self.alive = false;
+            return None;
         };
         let s = surface_at(scene, &hit, &ray);
         let material = &scene.materials[s.material as usize];
@@ -108,7 +157,7 @@ pub fn trace_path(
         let emission = Vec3::from(material.emission);
         if wo.dot(s.ng) > 0.0 && emission.max_element() > 0.0 {
             let object = &scene.objects[hit.object as usize];
-            let w = if prev_delta || object.light == NO_LIGHT {
+            let w = if self.prev_delta || object.light == NO_LIGHT {
                 1.0
             } else {
                 let pdf_light = light_pdf(
@@ -116,19 +165,20 @@ pub fn trace_path(
                     params,
                     hit.object,
                     hit.primitive,
-                    prev_position,
+                    self.prev_position,
                     s.position,
                     s.ng,
                 );
-                power_heuristic(prev_pdf, pdf_light)
+                power_heuristic(self.prev_pdf, pdf_light)
             };
-            radiance += throughput * emission * w;
+            self.sample.radiance += self.throughput * emission * w;
         }
-        if depth == params.max_depth {
-            break;
+        if self.depth == params.max_depth {
+            self.alive = false;
+            return None;
         }
         // Every bounce draws the same dimensions in the same order.
-        let [u_light_select, u_light, u_lobe, u_fresnel, u_bsdf, u_rr] = sampler.next_batch([
+        let [u_light_select, u_light, u_lobe, u_fresnel, u_bsdf, u_rr] = self.sampler.next_batch([
             Draw::One,
             Draw::Two,
             Draw::One,
@@ -140,42 +190,78 @@ pub fn trace_path(
             [u_light_select, u_lobe, u_fresnel, u_rr].map(|u| u.x);
         let color = base_color(scene, material, s.uv);
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
+        let mut shadow = None;
         if has_continuous_lobe(material) {
             let ls = sample_light(scene, params, s.position, n, u_light_select, u_light);
             if ls.valid {
                 let e = eval_bsdf(material, color, &s, wo, ls.wi);
                 if e.f.max_element() > 0.0 {
-                    rays += 1;
-                    if !occluded(tracer, s.position, s.ng, &ls) {
-                        radiance += throughput * e.f * ls.radiance * power_heuristic(ls.pdf, e.pdf)
+                    self.sample.rays += 1;
+                    let (ray, t_max) = shadow_ray(s.position, s.ng, &ls);
+                    let radiance =
+                        self.throughput * e.f * ls.radiance * power_heuristic(ls.pdf, e.pdf)
                             / ls.pdf;
-                    }
+                    shadow = Some(ShadowTest {
+                        ray,
+                        t_max,
+                        radiance,
+                    });
                 }
             }
         }
         let bs = sample_bsdf(material, color, &s, wo, u_lobe, u_fresnel, u_bsdf);
         if !bs.valid {
-            break;
+            self.alive = false;
+            return shadow;
         }
-        throughput *= bs.weight;
-        prev_pdf = bs.pdf;
-        prev_delta = bs.delta;
-        prev_position = s.position;
-        prev_normal = n;
-        eta_scale *= bs.eta;
-        if depth >= params.rr_depth {
-            let q = (throughput.max_element() * eta_scale * eta_scale).min(0.95);
+        self.throughput *= bs.weight;
+        self.prev_pdf = bs.pdf;
+        self.prev_delta = bs.delta;
+        self.prev_position = s.position;
+        self.prev_normal = n;
+        self.eta_scale *= bs.eta;
+        if self.depth >= params.rr_depth {
+            let q = (self.throughput.max_element() * self.eta_scale * self.eta_scale).min(0.95);
             if u_rr >= q {
-                break;
+                self.alive = false;
+                return shadow;
             }
-            throughput /= q;
+            self.throughput /= q;
         }
-        ray = Ray {
+        self.ray = Ray {
             origin: offset_origin(s.position, s.ng, bs.wi),
             dir: bs.wi,
         };
+        shadow
     }
-    PathSample { radiance, rays }
+
+    /// Adds the radiance of a [`ShadowTest`] whose ray nothing blocked.
+    #[inline(always)]
+    pub fn add_unblocked(&mut self, radiance: Vec3) {
+        self.sample.radiance += radiance;
+    }
+}
+
+/// Radiance along the path of sample `sampler` through pixel (x, y), its rays traced one
+/// by one by `tracer`. Twin of WGSL `trace_path`.
+#[inline(always)]
+pub fn trace_path(
+    tracer: &mut Tracer,
+    params: &GpuFrameParams,
+    x: u32,
+    y: u32,
+    sampler: Sampler,
+) -> PathSample {
+    let mut path = Path::new(params, x, y, sampler);
+    while path.alive {
+        let hit = tracer.intersect(&path.ray, T_MAX);
+        if let Some(shadow) = path.step(tracer.scene, params, hit)
+            && !tracer.occluded(&shadow.ray, shadow.t_max)
+        {
+            path.add_unblocked(shadow.radiance);
+        }
+    }
+    path.sample
 }
 
 /// A sample as it is accumulated: non-finite samples count as zero, channels are clamped to

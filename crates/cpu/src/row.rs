@@ -6,7 +6,10 @@ use std::ops::Range;
 use pathlight_core::Tracer;
 use pathlight_core::gpu::GpuFrameParams;
 
-use crate::integrator::{accumulated_value, camera_ray, trace_path};
+use glam::Vec3;
+use pathlight_core::packet::{PACKET, RayPacket};
+
+use crate::integrator::{Path, T_MAX, accumulated_value};
 use crate::sampler::Sampler;
 
 /// One row's share of an `advance`.
@@ -18,26 +21,82 @@ pub(crate) struct RowJob<'a> {
     pub samples: Range<u32>,
 }
 
-/// Adds the samples of `job` to its row's sums; returns the rays traced. The whole path
-/// tracer is inlined here, so that each [`InstructionSet`] level compiles all of it.
+/// Adds the samples of `job` to its row's sums; returns the rays traced. The row's samples
+/// (pixel by pixel, each pixel's in turn) are traced as paths side by side, [`PACKET`] at a
+/// time, their rays traced together as packets; a path that ends hands its lane to the next
+/// sample. The whole path tracer is inlined here, so that each [`InstructionSet`] level
+/// compiles all of it.
 #[inline(always)]
 fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
     let params = job.params;
+    let scene = tracer.scene;
+    let samples_per_pixel = job.samples.len();
+    let sample_count = row.len() * samples_per_pixel;
+    let mut next_sample = 0;
+    let mut lanes: [Option<(usize, Path)>; PACKET] = std::array::from_fn(|_| None);
     let mut rays = 0;
-    for (x, sum) in row.iter_mut().enumerate() {
-        let pixel = job.y * params.width + x as u32;
-        for i in job.samples.clone() {
-            let mut sampler = Sampler::new(params.sampler, pixel, i, params.seed);
-            let ray = camera_ray(params, x as u32, job.y, &mut sampler);
-            let path = trace_path(tracer, params, ray, &mut sampler);
-            rays += u64::from(path.rays);
-            let value = accumulated_value(path.radiance);
-            for c in 0..3 {
-                sum[c] += f64::from(value[c]);
+    loop {
+        let mut packet = RayPacket {
+            t_max: [T_MAX; PACKET],
+            ..RayPacket::default()
+        };
+        for (l, lane) in lanes.iter_mut().enumerate() {
+            while lane.is_none() && next_sample < sample_count {
+                let x = next_sample / samples_per_pixel;
+                let i = job.samples.start + (next_sample % samples_per_pixel) as u32;
+                next_sample += 1;
+                let pixel = job.y * params.width + x as u32;
+                let sampler = Sampler::new(params.sampler, pixel, i, params.seed);
+                let path = Path::new(params, x as u32, job.y, sampler);
+                if path.alive {
+                    *lane = Some((x, path));
+                } else {
+                    rays += finish(&path, &mut row[x]);
+                }
+            }
+            if let Some((_, path)) = lane {
+                packet.rays[l] = path.ray;
+                packet.active |= 1 << l;
+            }
+        }
+        if packet.active == 0 {
+            return rays;
+        }
+        let hits = tracer.intersect_packet(&packet);
+        let mut shadows = RayPacket::default();
+        let mut unblocked = [Vec3::ZERO; PACKET];
+        for (l, lane) in lanes.iter_mut().enumerate() {
+            if let Some((_, path)) = lane
+                && let Some(shadow) = path.step(scene, params, hits[l])
+            {
+                shadows.rays[l] = shadow.ray;
+                shadows.t_max[l] = shadow.t_max;
+                shadows.active |= 1 << l;
+                unblocked[l] = shadow.radiance;
+            }
+        }
+        let blocked = tracer.occluded_packet(&shadows);
+        for (l, lane) in lanes.iter_mut().enumerate() {
+            let Some((x, path)) = lane else { continue };
+            if (shadows.active & !blocked) >> l & 1 != 0 {
+                path.add_unblocked(unblocked[l]);
+            }
+            if !path.alive {
+                rays += finish(path, &mut row[*x]);
+                *lane = None;
             }
         }
     }
-    rays
+}
+
+/// Adds the sample of the ended `path` to its pixel's `sum`; returns its rays.
+#[inline(always)]
+fn finish(path: &Path, sum: &mut [f64; 3]) -> u64 {
+    let value = accumulated_value(path.sample.radiance);
+    for c in 0..3 {
+        sum[c] += f64::from(value[c]);
+    }
+    u64::from(path.sample.rays)
 }
 
 /// The instruction set a row renderer is compiled for: `render_row` is compiled once per

@@ -6,7 +6,7 @@
 
 use pathlight_core::{GpuScene, SceneSource, load_scene};
 use pathlight_cpu::CpuRenderer;
-use pathlight_cpu::integrator::{camera_ray, trace_path};
+use pathlight_cpu::integrator::trace_path;
 use pathlight_cpu::sampler::Sampler;
 
 use crate::common::render;
@@ -105,9 +105,8 @@ fn extreme_values_give_finite_samples_on_both_backends() {
     for y in 0..32 {
         for x in 0..32 {
             for i in 0..16 {
-                let mut sampler = Sampler::new(params.sampler, y * 32 + x, i, params.seed);
-                let ray = camera_ray(&params, x, y, &mut sampler);
-                let l = trace_path(&mut tracer, &params, ray, &mut sampler).radiance;
+                let sampler = Sampler::new(params.sampler, y * 32 + x, i, params.seed);
+                let l = trace_path(&mut tracer, &params, x, y, sampler).radiance;
                 assert!(
                     l.is_finite() && l.min_element() >= 0.0,
                     "pixel ({x}, {y}) sample {i}: {l}"

@@ -1,0 +1,543 @@
+//! Ray queries for packets of up to [`PACKET`] rays: the CPU backend traces its paths side
+//! by side, and their rays walk the [`WideBvh`] together, each child box and each shape
+//! tested for all of them at once. The per-ray arithmetic is written as loops over the
+//! lanes, which the compiler turns into SIMD instructions of the caller's instruction set
+//! (16 lanes: one AVX-512 register, two AVX2 ones). Where a packet has spread so that few of
+//! its rays still enter a node, each of those goes on alone with the single-ray walk.
+//!
+//! The shape tests are [`crate::trace`]'s, so each ray gets the same hit as alone (only the
+//! order of the walk differs, which can change the answer between two primitives at exactly
+//! the same distance).
+
+use std::ops::Range;
+
+use glam::Vec3;
+
+use crate::GpuScene;
+use crate::gpu::{FLAG_CAPS, KIND_MESH, KIND_QUAD, KIND_SPHERE};
+use crate::trace::{
+    Hit, Ray, intersect_cylinder, intersect_quad, intersect_sphere, intersect_triangle_edges,
+    safe_inverse,
+};
+use crate::wide_bvh::{Entry, Node4, RayLanes, Tracer, Walk, WideBvh};
+
+/// Rays per packet.
+pub const PACKET: usize = 16;
+
+/// Below this many rays entering a node, the packet's rays go on alone.
+const MIN_SHARED_RAYS: u32 = 3;
+
+/// A bit mask of lanes (bit `l` is lane `l`).
+type Lanes = u32;
+
+/// Up to [`PACKET`] rays to trace together.
+#[derive(Debug, Clone, Copy)]
+pub struct RayPacket {
+    /// The rays; only those in `active` are traced.
+    pub rays: [Ray; PACKET],
+    /// Per ray: the end of the searched interval `(0, t_max)`.
+    pub t_max: [f32; PACKET],
+    /// Bit `l` set: ray `l` is traced.
+    pub active: u32,
+}
+
+impl Default for RayPacket {
+    fn default() -> Self {
+        Self {
+            rays: [Ray {
+                origin: Vec3::ZERO,
+                dir: Vec3::Z,
+            }; PACKET],
+            t_max: [0.0; PACKET],
+            active: 0,
+        }
+    }
+}
+
+/// A packet's rays in structure-of-arrays form, per axis.
+struct PacketRays {
+    origin: [[f32; PACKET]; 3],
+    dir: [[f32; PACKET]; 3],
+    inv_dir: [[f32; PACKET]; 3],
+}
+
+impl PacketRays {
+    #[inline(always)]
+    fn new(packet: &RayPacket) -> Self {
+        let mut rays = Self {
+            origin: [[0.0; PACKET]; 3],
+            dir: [[1.0; PACKET]; 3],
+            inv_dir: [[1.0; PACKET]; 3],
+        };
+        for (l, ray) in packet.rays.iter().enumerate() {
+            let inv = safe_inverse(ray.dir);
+            for axis in 0..3 {
+                rays.origin[axis][l] = ray.origin[axis];
+                rays.dir[axis][l] = ray.dir[axis];
+                rays.inv_dir[axis][l] = inv[axis];
+            }
+        }
+        rays
+    }
+
+    #[inline(always)]
+    fn ray(&self, l: usize) -> Ray {
+        Ray {
+            origin: Vec3::new(self.origin[0][l], self.origin[1][l], self.origin[2][l]),
+            dir: Vec3::new(self.dir[0][l], self.dir[1][l], self.dir[2][l]),
+        }
+    }
+}
+
+/// The nearest hits found so far, per lane.
+struct PacketHits {
+    t: [f32; PACKET],
+    object: [u32; PACKET],
+    primitive: [u32; PACKET],
+    b1: [f32; PACKET],
+    b2: [f32; PACKET],
+    /// Lanes still searching: all active ones for nearest hits; an any-hit query drops a
+    /// lane once it has found something.
+    searching: Lanes,
+}
+
+impl PacketHits {
+    #[inline(always)]
+    fn get(&self, l: usize) -> Hit {
+        Hit {
+            t: self.t[l],
+            object: self.object[l],
+            primitive: self.primitive[l],
+            b1: self.b1[l],
+            b2: self.b2[l],
+        }
+    }
+
+    #[inline(always)]
+    fn set(&mut self, l: usize, hit: Hit) {
+        self.t[l] = hit.t;
+        self.object[l] = hit.object;
+        self.primitive[l] = hit.primitive;
+        self.b1[l] = hit.b1;
+        self.b2[l] = hit.b2;
+    }
+
+    /// Keeps, in the lanes of `lanes`, the hits on `shape` (`object`'s `primitive`) nearer
+    /// than the current ones.
+    #[inline(always)]
+    fn test(
+        &mut self,
+        rays: &PacketRays,
+        lanes: Lanes,
+        object: u32,
+        primitive: u32,
+        shape: &impl ShapeTest,
+    ) {
+        for l in 0..PACKET {
+            let (t, b1, b2) = shape.intersect(&rays.ray(l), self.t[l]);
+            let take = (lanes >> l) & 1 != 0 && t < self.t[l];
+            self.t[l] = if take { t } else { self.t[l] };
+            self.b1[l] = if take { b1 } else { self.b1[l] };
+            self.b2[l] = if take { b2 } else { self.b2[l] };
+            self.object[l] = if take { object } else { self.object[l] };
+            self.primitive[l] = if take { primitive } else { self.primitive[l] };
+        }
+    }
+
+    /// Lanes that have hit something.
+    #[inline(always)]
+    fn found(&self) -> Lanes {
+        let mut found = 0;
+        for l in 0..PACKET {
+            found |= u32::from(self.object[l] != u32::MAX) << l;
+        }
+        found
+    }
+}
+
+/// A shape a packet's rays are tested against, one by one ([`crate::trace`]'s tests).
+trait ShapeTest {
+    /// The hit `(t, b1, b2)` of `ray` in `(0, t_max)`, `t` = [`crate::trace::MISS`] for none.
+    fn intersect(&self, ray: &Ray, t_max: f32) -> (f32, f32, f32);
+}
+
+/// A quad: corner and edges.
+struct Quad(Vec3, Vec3, Vec3);
+
+/// A sphere: centre and radius.
+struct Sphere(Vec3, f32);
+
+/// A cylinder: axis ends, radius, whether capped.
+struct Cylinder(Vec3, Vec3, f32, bool);
+
+/// A triangle: first corner and the two edges from it.
+struct Triangle([Vec3; 3]);
+
+impl ShapeTest for Quad {
+    #[inline(always)]
+    fn intersect(&self, ray: &Ray, t_max: f32) -> (f32, f32, f32) {
+        intersect_quad(self.0, self.1, self.2, ray, t_max)
+    }
+}
+
+impl ShapeTest for Sphere {
+    #[inline(always)]
+    fn intersect(&self, ray: &Ray, t_max: f32) -> (f32, f32, f32) {
+        (intersect_sphere(self.0, self.1, ray, t_max), 0.0, 0.0)
+    }
+}
+
+impl ShapeTest for Cylinder {
+    #[inline(always)]
+    fn intersect(&self, ray: &Ray, t_max: f32) -> (f32, f32, f32) {
+        let t = intersect_cylinder(self.0, self.1, self.2, self.3, ray, t_max);
+        (t, 0.0, 0.0)
+    }
+}
+
+impl ShapeTest for Triangle {
+    #[inline(always)]
+    fn intersect(&self, ray: &Ray, t_max: f32) -> (f32, f32, f32) {
+        let [v0, e1, e2] = self.0;
+        intersect_triangle_edges(v0, e1, e2, ray, t_max)
+    }
+}
+
+/// Smaller of two numbers that are not NaN (one instruction, unlike `f32::min`).
+#[inline(always)]
+fn min(a: f32, b: f32) -> f32 {
+    if a < b { a } else { b }
+}
+
+/// Larger of two numbers that are not NaN.
+#[inline(always)]
+fn max(a: f32, b: f32) -> f32 {
+    if a > b { a } else { b }
+}
+
+impl Tracer<'_> {
+    /// Nearest hit in `(0, t_max)` of each active ray of `packet` (`None` for the others).
+    #[inline(always)]
+    pub fn intersect_packet(&mut self, packet: &RayPacket) -> [Option<Hit>; PACKET] {
+        let hits = self.trace_packet(packet, false);
+        std::array::from_fn(|l| {
+            let hit = hits.get(l);
+            (hit.object != u32::MAX).then_some(hit)
+        })
+    }
+
+    /// Bit `l` set: something lies on active ray `l` of `packet` in `(0, t_max)`.
+    #[inline(always)]
+    pub fn occluded_packet(&mut self, packet: &RayPacket) -> u32 {
+        self.trace_packet(packet, true).found() & packet.active
+    }
+
+    #[inline(always)]
+    fn trace_packet(&mut self, packet: &RayPacket, any_hit: bool) -> PacketHits {
+        let rays = PacketRays::new(packet);
+        let mut hits = PacketHits {
+            t: packet.t_max,
+            object: [u32::MAX; PACKET],
+            primitive: [0; PACKET],
+            b1: [0.0; PACKET],
+            b2: [0.0; PACKET],
+            searching: packet.active,
+        };
+        if self.bvh.has_objects && packet.active != 0 {
+            let walk = PacketWalk {
+                bvh: self.bvh,
+                scene: self.scene,
+                rays: &rays,
+                any_hit,
+            };
+            self.packet_stack.clear();
+            self.stack.clear();
+            let mut stacks = Stacks {
+                packet: &mut self.packet_stack,
+                single: &mut self.stack,
+            };
+            walk.tree(&mut stacks, 0, packet.active, &mut hits, &TopLevel);
+        }
+        hits
+    }
+}
+
+/// The two traversal stacks: nodes a packet still has to visit (with the lanes that
+/// entered them), and the single-ray walk's.
+struct Stacks<'a> {
+    packet: &'a mut Vec<(u32, Lanes)>,
+    single: &'a mut Vec<Entry>,
+}
+
+/// The tree a packet walks, which says what its leaves hold.
+trait Level {
+    /// Tests the leaf holding `range` with the rays `lanes`.
+    fn leaf(
+        &self,
+        walk: &PacketWalk,
+        stacks: &mut Stacks,
+        range: Range<u32>,
+        lanes: Lanes,
+        hits: &mut PacketHits,
+    );
+
+    /// Ray `lane` walks the subtree at `node` alone.
+    fn alone(
+        &self,
+        walk: &PacketWalk,
+        stacks: &mut Stacks,
+        lane: usize,
+        node: u32,
+        hits: &mut PacketHits,
+    );
+}
+
+/// The top level: leaves hold objects.
+struct TopLevel;
+
+/// The tree of mesh object `.0`: leaves hold triangles.
+struct Mesh(u32);
+
+impl Level for TopLevel {
+    #[inline(always)]
+    fn leaf(
+        &self,
+        walk: &PacketWalk,
+        stacks: &mut Stacks,
+        range: Range<u32>,
+        lanes: Lanes,
+        hits: &mut PacketHits,
+    ) {
+        walk.objects(stacks, range, lanes, hits);
+    }
+
+    #[inline(always)]
+    fn alone(
+        &self,
+        walk: &PacketWalk,
+        stacks: &mut Stacks,
+        lane: usize,
+        node: u32,
+        hits: &mut PacketHits,
+    ) {
+        walk.alone(stacks, lane, node, hits, None);
+    }
+}
+
+impl Level for Mesh {
+    #[inline(always)]
+    fn leaf(
+        &self,
+        walk: &PacketWalk,
+        _: &mut Stacks,
+        range: Range<u32>,
+        lanes: Lanes,
+        hits: &mut PacketHits,
+    ) {
+        walk.triangles(self.0, range, lanes, hits);
+    }
+
+    #[inline(always)]
+    fn alone(
+        &self,
+        walk: &PacketWalk,
+        stacks: &mut Stacks,
+        lane: usize,
+        node: u32,
+        hits: &mut PacketHits,
+    ) {
+        walk.alone(stacks, lane, node, hits, Some(self.0));
+    }
+}
+
+/// One packet query in progress.
+struct PacketWalk<'a> {
+    bvh: &'a WideBvh,
+    scene: &'a GpuScene,
+    rays: &'a PacketRays,
+    any_hit: bool,
+}
+
+impl PacketWalk<'_> {
+    /// Walks the tree at `root` with the rays `lanes`, nearest boxes first (as seen by the
+    /// rays entering them). Leaves go to `level` as their node is visited; where fewer than
+    /// [`MIN_SHARED_RAYS`] rays enter a node, each goes on alone from there.
+    #[inline(always)]
+    fn tree(
+        &self,
+        stacks: &mut Stacks,
+        root: u32,
+        lanes: Lanes,
+        hits: &mut PacketHits,
+        level: &impl Level,
+    ) {
+        let base = stacks.packet.len();
+        stacks.packet.push((root, lanes));
+        while stacks.packet.len() > base {
+            let Some((node, lanes)) = stacks.packet.pop() else {
+                break;
+            };
+            let mut lanes = lanes & hits.searching;
+            if lanes.count_ones() < MIN_SHARED_RAYS {
+                while lanes != 0 {
+                    let l = lanes.trailing_zeros() as usize;
+                    lanes &= lanes - 1;
+                    level.alone(self, stacks, l, node, hits);
+                }
+                continue;
+            }
+            let n = &self.bvh.nodes[node as usize];
+            // The entered children, nearest first by their nearest ray's entry distance.
+            let mut order = [(0.0f32, 0 as Lanes, 0usize); 4];
+            let mut entered = 0;
+            for child in 0..4 {
+                if n.lo[0][child] > n.hi[0][child] {
+                    continue; // An unused lane.
+                }
+                let (t, child_lanes) = self.enter(n, child, lanes, &hits.t);
+                if child_lanes == 0 {
+                    continue;
+                }
+                let mut k = entered;
+                while k > 0 && order[k - 1].0 > t {
+                    order[k] = order[k - 1];
+                    k -= 1;
+                }
+                order[k] = (t, child_lanes, child);
+                entered += 1;
+            }
+            for &(_, child_lanes, child) in &order[..entered] {
+                let child_lanes = child_lanes & hits.searching;
+                if n.count[child] > 0 && child_lanes != 0 {
+                    let first = n.first[child];
+                    let range = first..first + n.count[child];
+                    level.leaf(self, stacks, range, child_lanes, hits);
+                }
+            }
+            for &(_, child_lanes, child) in order[..entered].iter().rev() {
+                if n.count[child] == 0 {
+                    stacks.packet.push((n.first[child], child_lanes));
+                }
+            }
+        }
+    }
+
+    /// The rays of `lanes` that enter child `child` of `n` before their current nearest
+    /// hit `t`, and the smallest of their entry distances. Per ray the slab test of
+    /// [`RayLanes`].
+    #[inline(always)]
+    fn enter(&self, n: &Node4, child: usize, lanes: Lanes, t: &[f32; PACKET]) -> (f32, Lanes) {
+        let lo = [n.lo[0][child], n.lo[1][child], n.lo[2][child]];
+        let hi = [n.hi[0][child], n.hi[1][child], n.hi[2][child]];
+        let r = self.rays;
+        let mut near = [f32::INFINITY; PACKET];
+        let mut entered = 0;
+        for l in 0..PACKET {
+            let mut t_near = 0.0f32;
+            let mut t_far = t[l];
+            for axis in 0..3 {
+                let t0 = (lo[axis] - r.origin[axis][l]) * r.inv_dir[axis][l];
+                let t1 = (hi[axis] - r.origin[axis][l]) * r.inv_dir[axis][l];
+                t_near = max(t_near, min(t0, t1));
+                t_far = min(t_far, max(t0, t1));
+            }
+            let inside = (lanes >> l) & 1 != 0 && t_near <= t_far;
+            entered |= u32::from(inside) << l;
+            near[l] = if inside { t_near } else { f32::INFINITY };
+        }
+        let mut width = PACKET / 2;
+        while width > 0 {
+            for l in 0..width {
+                near[l] = min(near[l], near[l + width]);
+            }
+            width /= 2;
+        }
+        (near[0], entered)
+    }
+
+    /// Tests the top-level objects `range` with the rays `lanes`, walking the tree of each
+    /// mesh among them.
+    #[inline(always)]
+    fn objects(&self, stacks: &mut Stacks, range: Range<u32>, lanes: Lanes, hits: &mut PacketHits) {
+        for i in range {
+            let lanes = lanes & hits.searching;
+            if lanes == 0 {
+                return;
+            }
+            let o = &self.scene.objects[i as usize];
+            let a = Vec3::from_slice(&o.a);
+            let rays = self.rays;
+            match o.kind {
+                KIND_MESH => {
+                    let root = self.bvh.mesh_roots[i as usize];
+                    self.tree(stacks, root, lanes, hits, &Mesh(i));
+                }
+                KIND_QUAD => {
+                    let quad = Quad(a, Vec3::from_slice(&o.b), Vec3::from_slice(&o.c));
+                    hits.test(rays, lanes, i, 0, &quad);
+                }
+                KIND_SPHERE => hits.test(rays, lanes, i, 0, &Sphere(a, o.a[3])),
+                _ => {
+                    let caps = o.flags & FLAG_CAPS != 0;
+                    let cylinder = Cylinder(a, Vec3::from_slice(&o.b), o.a[3], caps);
+                    hits.test(rays, lanes, i, 0, &cylinder);
+                }
+            }
+            self.stop_found(hits);
+        }
+    }
+
+    /// Tests the triangles `range` of mesh object `object` with the rays `lanes`.
+    #[inline(always)]
+    fn triangles(&self, object: u32, range: Range<u32>, lanes: Lanes, hits: &mut PacketHits) {
+        for tri in range {
+            let triangle = Triangle(self.bvh.triangles[tri as usize]);
+            hits.test(self.rays, lanes & hits.searching, object, tri, &triangle);
+        }
+        self.stop_found(hits);
+    }
+
+    /// An any-hit query stops searching with the rays that found something.
+    #[inline(always)]
+    fn stop_found(&self, hits: &mut PacketHits) {
+        if self.any_hit {
+            hits.searching &= !hits.found();
+        }
+    }
+
+    /// Ray `lane` walks the subtree at `node` alone: of the top level, or of mesh `mesh`'s
+    /// tree.
+    #[inline(always)]
+    fn alone(
+        &self,
+        stacks: &mut Stacks,
+        lane: usize,
+        node: u32,
+        hits: &mut PacketHits,
+        mesh: Option<u32>,
+    ) {
+        let ray = self.rays.ray(lane);
+        let lanes = RayLanes::new(&ray);
+        let walk = Walk {
+            bvh: self.bvh,
+            scene: self.scene,
+            ray: &ray,
+            lanes: &lanes,
+            any_hit: self.any_hit,
+        };
+        let mut hit = hits.get(lane);
+        stacks.single.clear();
+        match mesh {
+            None => walk.tree(stacks.single, node, &mut hit, |stack, range, hit| {
+                walk.objects(stack, range, hit)
+            }),
+            Some(object) => walk.tree(stacks.single, node, &mut hit, |_, range, hit| {
+                walk.triangles(object, range, hit)
+            }),
+        };
+        hits.set(lane, hit);
+        if self.any_hit && hit.object != u32::MAX {
+            hits.searching &= !(1 << lane);
+        }
+    }
+}
