@@ -68,10 +68,13 @@ pub fn base_color(scene: &GpuScene, material: &GpuMaterial, uv: Vec2) -> Vec3 {
     }
 }
 
-/// Twin of WGSL `surface_at`.
+/// Twin of WGSL `surface_at`, except that sphere and cylinder texture coordinates (`atan2`,
+/// `acos`) are computed only for textured materials, the only ones that read them (zero
+/// otherwise).
 #[inline(always)]
 pub fn surface_at(scene: &GpuScene, hit: &Hit, ray: &Ray) -> Surface {
     let o = &scene.objects[hit.object as usize];
+    let textured = scene.materials[o.material as usize].texture >= 0;
     let [a, b, c] = [o.a, o.b, o.c].map(|v| Vec3::from_slice(&v));
     let p = ray.origin + hit.t * ray.dir;
     let mut s = Surface {
@@ -91,9 +94,11 @@ pub fn surface_at(scene: &GpuScene, hit: &Hit, ray: &Ray) -> Surface {
             let n = (p - a).normalize();
             s.ng = n;
             s.ns = n;
-            let phi = n.x.atan2(n.z) + o.b[0];
-            let u = 0.5 + phi / TAU;
-            s.uv = Vec2::new(u - u.floor(), n.y.clamp(-1.0, 1.0).acos() / PI);
+            if textured {
+                let phi = n.x.atan2(n.z) + o.b[0];
+                let u = 0.5 + phi / TAU;
+                s.uv = Vec2::new(u - u.floor(), n.y.clamp(-1.0, 1.0).acos() / PI);
+            }
         }
         KIND_CYLINDER => {
             let axis_full = b - a;
@@ -103,15 +108,20 @@ pub fn surface_at(scene: &GpuScene, hit: &Hit, ray: &Ray) -> Surface {
             let y = local.dot(axis);
             let radial = local - y * axis;
             let radius = o.a[3];
-            let frame = Frame::around(axis);
-            let phi = radial.dot(frame.b).atan2(radial.dot(frame.t));
-            let u = phi / TAU;
+            let u = if textured {
+                let frame = Frame::around(axis);
+                let phi = radial.dot(frame.b).atan2(radial.dot(frame.t));
+                let u = phi / TAU;
+                u - u.floor()
+            } else {
+                0.0
+            };
             if o.flags & FLAG_CAPS != 0 && radial.dot(radial) < radius * radius * 0.999 {
                 s.ng = if y < 0.5 * height { -axis } else { axis };
-                s.uv = Vec2::new(u - u.floor(), radial.length() / radius);
+                s.uv = Vec2::new(u, radial.length() / radius);
             } else {
                 s.ng = radial.normalize();
-                s.uv = Vec2::new(u - u.floor(), 1.0 - y / height);
+                s.uv = Vec2::new(u, 1.0 - y / height);
             }
             s.ns = s.ng;
         }
