@@ -187,7 +187,7 @@ pub struct Tracer<'a> {
     /// The single-ray walk's stack.
     pub(crate) stack: Vec<Entry>,
     /// The packet walk's stack: nodes and the rays that entered them.
-    pub(crate) packet_stack: Vec<(u32, u32)>,
+    pub(crate) packet_stack: Vec<(u32, crate::packet::Lanes)>,
 }
 
 impl<'a> Tracer<'a> {

@@ -4,7 +4,7 @@
 
 use glam::{Vec2, Vec3};
 use pathlight_core::gpu::{GpuBvhNode, KIND_MESH};
-use pathlight_core::packet::{PACKET, RayPacket};
+use pathlight_core::packet::{Lanes, PACKET, RayPacket};
 use pathlight_core::scene::{Camera, Lobes, Material, RenderSettings, TriangleMesh};
 use pathlight_core::trace::{Hit, Ray, intersect_triangle};
 use std::cell::RefCell;
@@ -228,7 +228,7 @@ fn assert_same(gpu: &GpuScene, rays: &[Ray]) -> usize {
         let lane = start % PACKET;
         let mut packet = RayPacket {
             t_max: [t_max; PACKET],
-            active: 0x7fbf | (1 << lane),
+            active: (Lanes::MAX >> (64 - PACKET)) & !0x0040_4040 | (1 << lane),
             ..RayPacket::default()
         };
         for (l, r) in packet.rays.iter_mut().enumerate() {

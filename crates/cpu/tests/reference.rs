@@ -164,7 +164,7 @@ fn every_instruction_set_renders_the_same_image() {
 
 #[test]
 fn packets_trace_each_path_as_it_is_traced_alone() {
-    // The renderer traces 16 paths side by side, their rays in packets; each path must come
+    // The renderer traces its paths side by side, their rays in packets; each path must come
     // out as `trace_path` (one ray at a time) gives it: same samples, same hits (pixel sums
     // within f64 rounding). Two primitives at exactly the same distance may be resolved
     // differently by the two walks: at most 0.5% of the pixels may differ.
