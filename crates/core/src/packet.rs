@@ -221,10 +221,13 @@ impl Tracer<'_> {
     #[inline(always)]
     pub fn intersect_packet(&mut self, packet: &RayPacket) -> [Option<Hit>; PACKET] {
         let hits = self.trace_packet(packet, false);
-        std::array::from_fn(|l| {
-            let hit = hits.get(l);
-            (hit.object != u32::MAX).then_some(hit)
-        })
+        let mut out = [None; PACKET];
+        for (l, hit) in out.iter_mut().enumerate() {
+            if hits.object[l] != u32::MAX {
+                *hit = Some(hits.get(l));
+            }
+        }
+        out
     }
 
     /// Bit `l` set: something lies on active ray `l` of `packet` in `(0, t_max)`.

@@ -186,8 +186,8 @@ impl Path {
             Draw::Two,
             Draw::One,
         ]);
-        let [u_light_select, u_lobe, u_fresnel, u_rr] =
-            [u_light_select, u_lobe, u_fresnel, u_rr].map(|u| u.x);
+        let (u_light_select, u_lobe, u_fresnel, u_rr) =
+            (u_light_select.x, u_lobe.x, u_fresnel.x, u_rr.x);
         let color = base_color(scene, material, s.uv);
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
         let mut shadow = None;
