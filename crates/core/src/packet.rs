@@ -449,6 +449,9 @@ impl PacketWalk<'_> {
             entered |= Lanes::from(inside) << l;
             near[l] = if inside { t_near } else { f32::INFINITY };
         }
+        if self.any_hit {
+            return (0.0, entered); // Any hit will do: no order needed.
+        }
         let mut width = PACKET / 2;
         while width > 0 {
             for l in 0..width {

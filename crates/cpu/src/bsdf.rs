@@ -82,8 +82,8 @@ pub fn fresnel_conductor(cos_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
     let eta2 = eta * eta;
     let k2 = k * k;
     let t0 = eta2 - k2 - sin2;
-    let a2pb2 = (t0 * t0 + 4.0 * eta2 * k2).max(Vec3::ZERO).powf(0.5);
-    let a = (0.5 * (a2pb2 + t0)).max(Vec3::ZERO).powf(0.5);
+    let a2pb2 = (t0 * t0 + 4.0 * eta2 * k2).max(Vec3::ZERO).map(f32::sqrt);
+    let a = (0.5 * (a2pb2 + t0)).max(Vec3::ZERO).map(f32::sqrt);
     let t1 = a2pb2 + cos2;
     let t2 = 2.0 * cos_i * a;
     let rs = (t1 - t2) / (t1 + t2).max(Vec3::splat(1e-20));
