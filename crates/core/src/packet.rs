@@ -285,15 +285,8 @@ trait Level {
         hits: &mut PacketHits,
     );
 
-    /// Ray `lane` walks the subtree at `node` alone.
-    fn alone(
-        &self,
-        walk: &PacketWalk,
-        stacks: &mut Stacks,
-        lane: usize,
-        node: u32,
-        hits: &mut PacketHits,
-    );
+    /// The mesh object whose tree this is; `None` for the top level.
+    fn mesh(&self) -> Option<u32>;
 }
 
 /// The top level: leaves hold objects.
@@ -316,15 +309,8 @@ impl Level for TopLevel {
     }
 
     #[inline(always)]
-    fn alone(
-        &self,
-        walk: &PacketWalk,
-        stacks: &mut Stacks,
-        lane: usize,
-        node: u32,
-        hits: &mut PacketHits,
-    ) {
-        walk.alone(stacks, lane, node, hits, None);
+    fn mesh(&self) -> Option<u32> {
+        None
     }
 }
 
@@ -342,15 +328,8 @@ impl Level for Mesh {
     }
 
     #[inline(always)]
-    fn alone(
-        &self,
-        walk: &PacketWalk,
-        stacks: &mut Stacks,
-        lane: usize,
-        node: u32,
-        hits: &mut PacketHits,
-    ) {
-        walk.alone(stacks, lane, node, hits, Some(self.0));
+    fn mesh(&self) -> Option<u32> {
+        Some(self.0)
     }
 }
 
@@ -386,7 +365,7 @@ impl PacketWalk<'_> {
                 while lanes != 0 {
                     let l = lanes.trailing_zeros() as usize;
                     lanes &= lanes - 1;
-                    level.alone(self, stacks, l, node, hits);
+                    self.alone(stacks, l, node, hits, level.mesh());
                 }
                 continue;
             }
