@@ -90,8 +90,9 @@ impl PacketRays {
     }
 }
 
-/// The nearest hits found so far, per lane.
-struct PacketHits {
+/// The nearest hits of a packet's rays (found so far, during its walk).
+#[derive(Debug, Clone)]
+pub struct PacketHits {
     t: [f32; PACKET],
     object: [u32; PACKET],
     primitive: [u32; PACKET],
@@ -103,6 +104,12 @@ struct PacketHits {
 }
 
 impl PacketHits {
+    /// The hit of ray `lane`, if it hit anything.
+    #[inline(always)]
+    pub fn hit(&self, lane: usize) -> Option<Hit> {
+        (self.object[lane] != u32::MAX).then(|| self.get(lane))
+    }
+
     #[inline(always)]
     fn get(&self, l: usize) -> Hit {
         Hit {
@@ -217,17 +224,10 @@ fn max(a: f32, b: f32) -> f32 {
 }
 
 impl Tracer<'_> {
-    /// Nearest hit in `(0, t_max)` of each active ray of `packet` (`None` for the others).
+    /// Nearest hit in `(0, t_max)` of each active ray of `packet` (none for the others).
     #[inline(always)]
-    pub fn intersect_packet(&mut self, packet: &RayPacket) -> [Option<Hit>; PACKET] {
-        let hits = self.trace_packet(packet, false);
-        let mut out = [None; PACKET];
-        for (l, hit) in out.iter_mut().enumerate() {
-            if hits.object[l] != u32::MAX {
-                *hit = Some(hits.get(l));
-            }
-        }
-        out
+    pub fn intersect_packet(&mut self, packet: &RayPacket) -> PacketHits {
+        self.trace_packet(packet, false)
     }
 
     /// Bit `l` set: something lies on active ray `l` of `packet` in `(0, t_max)`.

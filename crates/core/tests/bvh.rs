@@ -253,7 +253,7 @@ fn assert_same(gpu: &GpuScene, rays: &[Ray]) -> usize {
             "packet",
             &|r, t| {
                 let (packet, lane) = packet_of(r, t);
-                tracer.borrow_mut().intersect_packet(&packet)[lane]
+                tracer.borrow_mut().intersect_packet(&packet).hit(lane)
             },
             &|r, t| {
                 let (packet, lane) = packet_of(r, t);

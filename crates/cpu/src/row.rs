@@ -35,11 +35,14 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
     let mut next_sample = 0;
     let mut lanes: [Option<(usize, Path)>; PACKET] = std::array::from_fn(|_| None);
     let mut rays = 0;
+    // Reused from round to round: only the lanes in use are written.
+    let mut packet = RayPacket {
+        t_max: [T_MAX; PACKET],
+        ..RayPacket::default()
+    };
+    let mut shadows = RayPacket::default();
     loop {
-        let mut packet = RayPacket {
-            t_max: [T_MAX; PACKET],
-            ..RayPacket::default()
-        };
+        packet.active = 0;
         for (l, lane) in lanes.iter_mut().enumerate() {
             while lane.is_none() && next_sample < sample_count {
                 let x = next_sample / samples_per_pixel;
@@ -63,11 +66,11 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
             return rays;
         }
         let hits = tracer.intersect_packet(&packet);
-        let mut shadows = RayPacket::default();
+        shadows.active = 0;
         let mut unblocked = [Vec3::ZERO; PACKET];
         for (l, lane) in lanes.iter_mut().enumerate() {
             if let Some((_, path)) = lane
-                && let Some(shadow) = path.step(scene, params, hits[l])
+                && let Some(shadow) = path.step(scene, params, hits.hit(l))
             {
                 shadows.rays[l] = shadow.ray;
                 shadows.t_max[l] = shadow.t_max;
