@@ -25,7 +25,7 @@ use crate::wide_bvh::{Entry, Node4, RayLanes, Tracer, Walk, WideBvh};
 pub const PACKET: usize = 32;
 
 /// Below this many rays entering a node, the packet's rays go on alone.
-const MIN_SHARED_RAYS: u32 = 3;
+const MIN_SHARED_RAYS: u32 = 5;
 
 /// A bit mask of a packet's lanes (bit `l` is lane `l`).
 pub type Lanes = u64;
