@@ -3,10 +3,9 @@
 
 use std::ops::Range;
 
+use glam::Vec3;
 use pathlight_core::Tracer;
 use pathlight_core::gpu::GpuFrameParams;
-
-use glam::Vec3;
 use pathlight_core::packet::{PACKET, RayPacket};
 
 use crate::integrator::{Path, T_MAX, accumulated_value};
