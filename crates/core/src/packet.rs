@@ -2,8 +2,9 @@
 //! by side, and their rays walk the [`WideBvh`] together, each child box and each shape
 //! tested for all of them at once. The per-ray arithmetic is written as loops over the
 //! lanes, which the compiler turns into SIMD instructions of the caller's instruction set
-//! (32 lanes: two AVX-512 registers, four AVX2 ones; 32 measured faster than 16 and 8). Where a packet has spread so that few of
-//! its rays still enter a node, each of those goes on alone with the single-ray walk.
+//! (32 lanes: two AVX-512 registers, four AVX2 ones; 32 measured faster than 16 and 8).
+//! Where a packet has spread so that few of its rays still enter a node, each of those goes
+//! on alone with the single-ray walk.
 //!
 //! The shape tests are [`crate::trace`]'s, so each ray gets the same hit as alone (only the
 //! order of the walk differs, which can change the answer between two primitives at exactly

@@ -13,6 +13,7 @@ use obvhs::aabb::Aabb;
 
 use crate::accel::GpuScene;
 use crate::gpu::{GpuBvhNode, KIND_MESH};
+use crate::packet::Lanes;
 use crate::trace::{Hit, Ray, intersect_triangle_edges, safe_inverse};
 
 /// Four child boxes in structure-of-arrays form, and what each child is.
@@ -174,8 +175,8 @@ impl WideBvh {
     }
 }
 
-/// Ray queries from one thread against a scene and its [`WideBvh`]. It keeps the traversal
-/// stack that every query reuses, so that queries allocate nothing once it has grown to the
+/// Ray queries from one thread against a scene and its [`WideBvh`], one ray at a time or in
+/// packets ([`crate::packet`]). It keeps the traversal stacks that every query reuses, so that queries allocate nothing once it has grown to the
 /// tree's needs, and so that the whole walk inlines into the caller (compiled for its
 /// instruction set).
 #[derive(Debug, Clone)]
@@ -187,7 +188,7 @@ pub struct Tracer<'a> {
     /// The single-ray walk's stack.
     pub(crate) stack: Vec<Entry>,
     /// The packet walk's stack: nodes and the rays that entered them.
-    pub(crate) packet_stack: Vec<(u32, crate::packet::Lanes)>,
+    pub(crate) packet_stack: Vec<(u32, Lanes)>,
 }
 
 impl<'a> Tracer<'a> {
