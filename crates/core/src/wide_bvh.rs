@@ -176,9 +176,9 @@ impl WideBvh {
 }
 
 /// Ray queries from one thread against a scene and its [`WideBvh`], one ray at a time or in
-/// packets ([`crate::packet`]). It keeps the traversal stacks that every query reuses, so that queries allocate nothing once it has grown to the
-/// tree's needs, and so that the whole walk inlines into the caller (compiled for its
-/// instruction set).
+/// packets ([`crate::packet`]). It keeps the traversal stacks that every query reuses, so
+/// that queries allocate nothing once they have grown to the tree's needs, and so that the
+/// whole walk inlines into the caller (compiled for its instruction set).
 #[derive(Debug, Clone)]
 pub struct Tracer<'a> {
     /// The scene.
