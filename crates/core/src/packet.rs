@@ -39,7 +39,7 @@ pub struct RayPacket {
     pub rays: [Ray; PACKET],
     /// Per ray: the end of the searched interval `(0, t_max)`.
     pub t_max: [f32; PACKET],
-    /// Bit `l` set: ray `l` is traced.
+    /// Bit `l` set: ray `l` is traced (bits from [`PACKET`] up are ignored).
     pub active: Lanes,
 }
 
@@ -234,21 +234,23 @@ impl Tracer<'_> {
     /// Bit `l` set: something lies on active ray `l` of `packet` in `(0, t_max)`.
     #[inline(always)]
     pub fn occluded_packet(&mut self, packet: &RayPacket) -> Lanes {
-        self.trace_packet(packet, true).found() & packet.active
+        // Only traced lanes can have found something.
+        self.trace_packet(packet, true).found()
     }
 
     #[inline(always)]
     fn trace_packet(&mut self, packet: &RayPacket, any_hit: bool) -> PacketHits {
         let rays = PacketRays::new(packet);
+        let active = packet.active & (Lanes::MAX >> (Lanes::BITS as usize - PACKET));
         let mut hits = PacketHits {
             t: packet.t_max,
             object: [u32::MAX; PACKET],
             primitive: [0; PACKET],
             b1: [0.0; PACKET],
             b2: [0.0; PACKET],
-            searching: packet.active,
+            searching: active,
         };
-        if self.bvh.has_objects && packet.active != 0 {
+        if self.bvh.has_objects && active != 0 {
             let walk = PacketWalk {
                 bvh: self.bvh,
                 scene: self.scene,
@@ -261,7 +263,7 @@ impl Tracer<'_> {
                 packet: &mut self.packet_stack,
                 single: &mut self.stack,
             };
-            walk.tree(&mut stacks, 0, packet.active, &mut hits, &TopLevel);
+            walk.tree(&mut stacks, 0, active, &mut hits, &TopLevel);
         }
         hits
     }

@@ -221,14 +221,21 @@ type Traversal<'a> = (
 fn assert_same(gpu: &GpuScene, rays: &[Ray]) -> usize {
     let wide = WideBvh::build(gpu);
     let tracer = RefCell::new(Tracer::new(gpu, &wide));
-    // The ray in a packet with others of `rays` (a lane left out here and there), at a lane
-    // that depends on the ray.
+    // The ray in a packet with others of `rays`, at a lane that depends on the ray.
     let packet_of = |ray: &Ray, t_max: f32| {
         let start = ray.origin.x.to_bits() as usize % rays.len();
         let lane = start % PACKET;
+        // Every other packet holds this ray alone (it walks alone from the root), the others
+        // most lanes; a bit beyond the packet's lanes is set too and must be ignored.
+        let beyond = Lanes::from(1u8).checked_shl(PACKET as u32).unwrap_or(0);
+        let others = if start.is_multiple_of(2) {
+            !0x0040_4040
+        } else {
+            0
+        };
         let mut packet = RayPacket {
             t_max: [t_max; PACKET],
-            active: (Lanes::MAX >> (64 - PACKET)) & !0x0040_4040 | (1 << lane),
+            active: others | beyond | (1 << lane),
             ..RayPacket::default()
         };
         for (l, r) in packet.rays.iter_mut().enumerate() {
