@@ -4,12 +4,13 @@
 use glam::Vec3;
 use pathlight_core::gpu::{GpuFrameParams, NO_LIGHT};
 use pathlight_core::trace::{Hit, Ray};
-use pathlight_core::{GpuScene, Tracer};
+use pathlight_core::Tracer;
 
 use crate::bsdf::{eval_bsdf, has_continuous_lobe, sample_bsdf};
 use crate::lights::{LightSample, env_pdf, light_pdf, sample_light};
 use crate::sampler::{Draw, Sampler};
 use crate::sampling::power_heuristic;
+use crate::scene::CpuScene;
 use crate::surface::{base_color, surface_at};
 
 /// Largest radiance one sample may add per channel (WGSL `SAMPLE_MAX`).
@@ -134,7 +135,7 @@ impl Path {
     #[inline(always)]
     pub fn step(
         &mut self,
-        scene: &GpuScene,
+        scene: &CpuScene,
         params: &GpuFrameParams,
         hit: Option<Hit>,
     ) -> Option<ShadowTest> {
@@ -152,11 +153,11 @@ impl Path {
             return None;
         };
         let s = surface_at(scene, &hit, &ray);
-        let material = &scene.materials[s.material as usize];
+        let material = &scene.gpu.materials[s.material as usize];
         let wo = -ray.dir;
         let emission = Vec3::from(material.emission);
         if wo.dot(s.ng) > 0.0 && emission.max_element() > 0.0 {
-            let object = &scene.objects[hit.object as usize];
+            let object = &scene.gpu.objects[hit.object as usize];
             let w = if self.prev_delta || object.light == NO_LIGHT {
                 1.0
             } else {
@@ -188,7 +189,7 @@ impl Path {
         ]);
         let (u_light_select, u_lobe, u_fresnel, u_rr) =
             (u_light_select.x, u_lobe.x, u_fresnel.x, u_rr.x);
-        let color = base_color(scene, material, s.uv);
+        let color = base_color(&scene.gpu, material, s.uv);
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
         let mut shadow = None;
         if has_continuous_lobe(material) {
@@ -242,11 +243,12 @@ impl Path {
     }
 }
 
-/// Radiance along the path of sample `sampler` through pixel (x, y), its rays traced one
-/// by one by `tracer`. Twin of WGSL `trace_path`.
+/// Radiance along the path of sample `sampler` through pixel (x, y) of `scene`, its rays
+/// traced one by one by `tracer` (which traces in `scene`). Twin of WGSL `trace_path`.
 #[inline(always)]
 pub fn trace_path(
     tracer: &mut Tracer,
+    scene: &CpuScene,
     params: &GpuFrameParams,
     x: u32,
     y: u32,
@@ -255,7 +257,7 @@ pub fn trace_path(
     let mut path = Path::new(params, x, y, sampler);
     while path.alive {
         let hit = tracer.intersect(&path.ray, T_MAX);
-        if let Some(shadow) = path.step(tracer.scene, params, hit)
+        if let Some(shadow) = path.step(scene, params, hit)
             && !tracer.occluded(&shadow.ray, shadow.t_max)
         {
             path.add_unblocked(shadow.radiance);

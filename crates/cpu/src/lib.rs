@@ -9,6 +9,7 @@ pub mod lights;
 mod row;
 pub mod sampler;
 pub mod sampling;
+pub mod scene;
 pub mod surface;
 
 use std::time::{Duration, Instant};
@@ -16,6 +17,8 @@ use std::time::{Duration, Instant};
 use pathlight_core::frame::frame_params;
 use pathlight_core::gpu::GpuFrameParams;
 use pathlight_core::{Film, GpuScene, Scene, Tracer, WideBvh};
+
+use crate::scene::CpuScene;
 use rayon::prelude::*;
 
 pub use crate::row::InstructionSet;
@@ -27,7 +30,7 @@ const TARGET_BATCH: Duration = Duration::from_millis(250);
 /// A progressive render on the CPU.
 #[derive(Debug)]
 pub struct CpuRenderer {
-    scene: GpuScene,
+    scene: CpuScene,
     /// The scene's 4-wide BVH, which the CPU traces rays in.
     bvh: WideBvh,
     params: GpuFrameParams,
@@ -48,7 +51,7 @@ impl CpuRenderer {
         let pixels = (params.width * params.height) as usize;
         Self {
             bvh: WideBvh::build(&gpu_scene),
-            scene: gpu_scene,
+            scene: CpuScene::new(gpu_scene),
             params,
             sums: vec![[0.0; 3]; pixels],
             samples_done: 0,
@@ -95,9 +98,10 @@ impl CpuRenderer {
             .par_chunks_mut(width)
             .enumerate()
             .map_init(
-                || Tracer::new(scene, bvh),
+                || Tracer::new(&scene.gpu, bvh),
                 |tracer, (y, row)| {
                     let job = RowJob {
+                        scene,
                         params,
                         y: y as u32,
                         samples: offset..offset + samples,

@@ -9,13 +9,13 @@
 use std::f32::consts::{PI, TAU};
 
 use glam::{Vec2, Vec3};
-use pathlight_core::GpuScene;
 use pathlight_core::gpu::{
-    FLAG_CAPS, GpuFrameParams, GpuObject, KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE,
+    FLAG_CAPS, GpuFrameParams, KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE,
 };
 use pathlight_core::trace::{MISS, Ray, intersect_sphere};
 
 use crate::sampling::{Frame, sample_cosine_hemisphere, sample_disk, sample_uniform_sphere};
+use crate::scene::CpuScene;
 
 /// A sampled light direction. Twin of WGSL `LightSample`.
 #[derive(Debug, Clone, Copy)]
@@ -68,7 +68,7 @@ fn sphere_cone(center: Vec3, radius: f32, p: Vec3) -> f32 {
 /// `light_pdf`.
 #[inline(always)]
 pub fn light_pdf(
-    scene: &GpuScene,
+    scene: &CpuScene,
     params: &GpuFrameParams,
     object: u32,
     primitive: u32,
@@ -76,13 +76,13 @@ pub fn light_pdf(
     p_light: Vec3,
     n_light: Vec3,
 ) -> f32 {
-    let o = &scene.objects[object as usize];
+    let o = &scene.gpu.objects[object as usize];
     let entry = if o.kind == KIND_MESH {
         o.light + primitive - o.first_triangle
     } else {
         o.light
     };
-    let pmf = scene.lights[entry as usize].pmf * (1.0 - params.env_pmf);
+    let pmf = scene.gpu.lights[entry as usize].pmf * (1.0 - params.env_pmf);
     let to_light = p_light - p;
     let d2 = to_light.length_squared();
     let cos_l = n_light.dot(-to_light).abs() / d2.sqrt();
@@ -92,7 +92,7 @@ pub fn light_pdf(
             return pmf / (TAU * one_minus_cos);
         }
     }
-    let area = scene.emitter_area(o, primitive);
+    let area = scene.emitter_area(object, o, primitive);
     if cos_l <= 0.0 || area <= 0.0 {
         return 0.0;
     }
@@ -104,19 +104,20 @@ pub fn light_pdf(
 /// WGSL `sample_shape`.
 #[inline(always)]
 fn sample_shape(
-    scene: &GpuScene,
-    o: &GpuObject,
+    scene: &CpuScene,
+    object: u32,
     primitive: u32,
     p: Vec3,
     u: Vec2,
     u_part: f32,
 ) -> (Vec3, Vec3, f32) {
+    let o = &scene.gpu.objects[object as usize];
     let [a, b, c] = [o.a, o.b, o.c].map(|v| Vec3::from_slice(&v));
     match o.kind {
         KIND_QUAD => (
             a + u.x * b + u.y * c,
-            b.cross(c).normalize(),
-            1.0 / b.cross(c).length(),
+            scene.quad_normal(object),
+            1.0 / scene.emitter_area(object, o, primitive),
         ),
         KIND_SPHERE => {
             let radius = o.a[3];
@@ -147,7 +148,7 @@ fn sample_shape(
             let height = axis_full.length();
             let axis = axis_full / height;
             let frame = Frame::around(axis);
-            let area = scene.emitter_area(o, primitive);
+            let area = scene.emitter_area(object, o, primitive);
             let side = TAU * radius * height;
             if u_part * area < side || o.flags & FLAG_CAPS == 0 {
                 let phi = TAU * u.x;
@@ -169,7 +170,7 @@ fn sample_shape(
             }
         }
         _ => {
-            let [v0, v1, v2] = scene.triangle(primitive);
+            let [v0, v1, v2] = scene.gpu.triangle(primitive);
             let su = u.x.sqrt();
             let (b1, b2) = (1.0 - su, u.y * su);
             let cross = (v1 - v0).cross(v2 - v0);
@@ -186,7 +187,7 @@ fn sample_shape(
 /// is gathered from). Twin of WGSL `sample_light`.
 #[inline(always)]
 pub fn sample_light(
-    scene: &GpuScene,
+    cpu_scene: &CpuScene,
     params: &GpuFrameParams,
     p: Vec3,
     n: Vec3,
@@ -209,6 +210,7 @@ pub fn sample_light(
     if params.light_count == 0 {
         return INVALID;
     }
+    let scene = &cpu_scene.gpu;
     let u_light = ((u_select - params.env_pmf) / (1.0 - params.env_pmf)).min(0.999_999_94);
     // First entry whose cumulative probability exceeds u_light.
     let (mut lo, mut hi) = (0u32, params.light_count - 1);
@@ -225,7 +227,7 @@ pub fn sample_light(
     let below = light.cdf - light.pmf;
     let u_part = ((u_light - below) / light.pmf.max(1e-30)).clamp(0.0, 1.0);
     let o = &scene.objects[light.object as usize];
-    let (q, n, density) = sample_shape(scene, o, light.primitive, p, u, u_part);
+    let (q, n, density) = sample_shape(cpu_scene, light.object, light.primitive, p, u, u_part);
     let to_light = q - p;
     let distance = to_light.length();
     if distance <= 0.0 {

@@ -10,9 +10,11 @@ use pathlight_core::packet::{PACKET, RayPacket};
 
 use crate::integrator::{Path, T_MAX, accumulated_value};
 use crate::sampler::Sampler;
+use crate::scene::CpuScene;
 
 /// One row's share of an `advance`.
 pub(crate) struct RowJob<'a> {
+    pub scene: &'a CpuScene,
     pub params: &'a GpuFrameParams,
     /// The row.
     pub y: u32,
@@ -27,8 +29,7 @@ pub(crate) struct RowJob<'a> {
 /// compiles all of it.
 #[inline(always)]
 fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
-    let params = job.params;
-    let scene = tracer.scene;
+    let (scene, params) = (job.scene, job.params);
     let samples_per_pixel = job.samples.len();
     let sample_count = row.len() * samples_per_pixel;
     let mut next_sample = 0;

@@ -10,6 +10,7 @@ use pathlight_core::gpu::{
 use pathlight_core::trace::{Hit, Ray};
 
 use crate::sampling::Frame;
+use crate::scene::CpuScene;
 
 /// The surface at a hit. Twin of WGSL `Surface`.
 #[derive(Debug, Clone, Copy)]
@@ -72,10 +73,11 @@ pub fn base_color(scene: &GpuScene, material: &GpuMaterial, uv: Vec2) -> Vec3 {
 /// `acos`) are computed only for textured materials, the only ones that read them (zero
 /// otherwise).
 #[inline(always)]
-pub fn surface_at(scene: &GpuScene, hit: &Hit, ray: &Ray) -> Surface {
+pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
+    let scene = &cpu_scene.gpu;
     let o = &scene.objects[hit.object as usize];
     let textured = scene.materials[o.material as usize].texture >= 0;
-    let [a, b, c] = [o.a, o.b, o.c].map(|v| Vec3::from_slice(&v));
+    let [a, b] = [o.a, o.b].map(|v| Vec3::from_slice(&v));
     let p = ray.origin + hit.t * ray.dir;
     let mut s = Surface {
         position: p,
@@ -86,7 +88,7 @@ pub fn surface_at(scene: &GpuScene, hit: &Hit, ray: &Ray) -> Surface {
     };
     match o.kind {
         KIND_QUAD => {
-            s.ng = b.cross(c).normalize();
+            s.ng = cpu_scene.quad_normal(hit.object);
             s.ns = s.ng;
             s.uv = Vec2::new(hit.b1, 1.0 - hit.b2);
         }

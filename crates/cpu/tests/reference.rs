@@ -13,6 +13,7 @@ use pathlight_core::frame::frame_params;
 use pathlight_core::{Film, GpuScene, Tracer, WideBvh, load_scene_file};
 use pathlight_cpu::integrator::{accumulated_value, trace_path};
 use pathlight_cpu::sampler::Sampler;
+use pathlight_cpu::scene::CpuScene;
 use pathlight_cpu::{CpuRenderer, InstructionSet};
 
 /// Mitsuba 3.9.1's own relMSE at 128x128, 64 spp, llvm_ad_rgb, mean over seeds 0-7, from
@@ -181,13 +182,14 @@ fn packets_trace_each_path_as_it_is_traced_alone() {
     let params = frame_params(&scene, &gpu_scene);
     let bvh = WideBvh::build(&gpu_scene);
     let mut tracer = Tracer::new(&gpu_scene, &bvh);
+    let cpu_scene = CpuScene::new(gpu_scene.clone());
     let mut differing = 0;
     for y in 0..size {
         for x in 0..size {
             let mut sum = [0.0f64; 3];
             for i in 0..spp {
                 let sampler = Sampler::new(params.sampler, y * size + x, i, params.seed);
-                let path = trace_path(&mut tracer, &params, x, y, sampler);
+                let path = trace_path(&mut tracer, &cpu_scene, &params, x, y, sampler);
                 let value = accumulated_value(path.radiance);
                 for c in 0..3 {
                     sum[c] += f64::from(value[c]);

@@ -7,6 +7,7 @@
 use pathlight_core::{GpuScene, SceneSource, load_scene};
 use pathlight_cpu::CpuRenderer;
 use pathlight_cpu::integrator::trace_path;
+use pathlight_cpu::scene::CpuScene;
 use pathlight_cpu::sampler::Sampler;
 
 use crate::common::render;
@@ -101,12 +102,13 @@ fn extreme_values_give_finite_samples_on_both_backends() {
     let params = pathlight_core::frame::frame_params(&s, &gpu_scene);
     let bvh = pathlight_core::WideBvh::build(&gpu_scene);
     let mut tracer = pathlight_core::Tracer::new(&gpu_scene, &bvh);
+    let cpu_scene = CpuScene::new(gpu_scene.clone());
     let mut nonzero = 0;
     for y in 0..32 {
         for x in 0..32 {
             for i in 0..16 {
                 let sampler = Sampler::new(params.sampler, y * 32 + x, i, params.seed);
-                let l = trace_path(&mut tracer, &params, x, y, sampler).radiance;
+                let l = trace_path(&mut tracer, &cpu_scene, &params, x, y, sampler).radiance;
                 assert!(
                     l.is_finite() && l.min_element() >= 0.0,
                     "pixel ({x}, {y}) sample {i}: {l}"
