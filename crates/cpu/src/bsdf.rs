@@ -18,7 +18,7 @@ use std::f32::consts::{FRAC_1_PI, PI};
 use glam::{Vec2, Vec3};
 use pathlight_core::gpu::GpuMaterial;
 
-use crate::sampling::{Frame, sample_cosine_hemisphere};
+use crate::sampling::{Frame, sample_cosine_hemisphere, sin_cos_turns};
 use crate::surface::Surface;
 
 /// GGX alpha below which a lobe is treated as perfectly smooth.
@@ -134,10 +134,10 @@ pub fn ggx_sample_visible(wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
     };
     let t2 = vh.cross(t1);
     let r = u.x.sqrt();
-    let phi = 2.0 * PI * u.y;
-    let p1 = r * phi.cos();
+    let (sin, cos) = sin_cos_turns(u.y);
+    let p1 = r * cos;
     let s = 0.5 * (1.0 + vh.z);
-    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
+    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sin;
     let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
     Vec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(1e-7)).normalize()
 }

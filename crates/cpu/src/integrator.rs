@@ -2,9 +2,9 @@
 //! `integrator.wgsl` (same loop, same order of sample dimensions).
 
 use glam::Vec3;
+use pathlight_core::Tracer;
 use pathlight_core::gpu::{GpuFrameParams, NO_LIGHT};
 use pathlight_core::trace::{Hit, Ray};
-use pathlight_core::Tracer;
 
 use crate::bsdf::{eval_bsdf, has_continuous_lobe, sample_bsdf};
 use crate::lights::{LightSample, env_pdf, light_pdf, sample_light};

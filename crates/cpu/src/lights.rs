@@ -14,7 +14,9 @@ use pathlight_core::gpu::{
 };
 use pathlight_core::trace::{MISS, Ray, intersect_sphere};
 
-use crate::sampling::{Frame, sample_cosine_hemisphere, sample_disk, sample_uniform_sphere};
+use crate::sampling::{
+    Frame, sample_cosine_hemisphere, sample_disk, sample_uniform_sphere, sin_cos_turns,
+};
 use crate::scene::CpuScene;
 
 /// A sampled light direction. Twin of WGSL `LightSample`.
@@ -125,10 +127,10 @@ fn sample_shape(
             if one_minus_cos > 0.0 {
                 let cos_theta = 1.0 - u.x * one_minus_cos;
                 let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-                let phi = TAU * u.y;
+                let (sin, cos) = sin_cos_turns(u.y);
                 let dir = Frame::around((a - p).normalize()).to_world(Vec3::new(
-                    sin_theta * phi.cos(),
-                    sin_theta * phi.sin(),
+                    sin_theta * cos,
+                    sin_theta * sin,
                     cos_theta,
                 ));
                 let ray = Ray { origin: p, dir };
@@ -151,8 +153,8 @@ fn sample_shape(
             let area = scene.emitter_area(object, o, primitive);
             let side = TAU * radius * height;
             if u_part * area < side || o.flags & FLAG_CAPS == 0 {
-                let phi = TAU * u.x;
-                let radial = frame.t * phi.cos() + frame.b * phi.sin();
+                let (sin, cos) = sin_cos_turns(u.x);
+                let radial = frame.t * cos + frame.b * sin;
                 (
                     a + axis * (u.y * height) + radial * radius,
                     radial,

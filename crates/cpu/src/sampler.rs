@@ -101,10 +101,18 @@ impl Sampler {
         let sobol = kind == SAMPLER_SOBOL;
         Self {
             kind,
-            pixel_seed: if sobol { pcg_hash(pixel ^ pcg_hash(seed)) } else { 0 },
+            pixel_seed: if sobol {
+                pcg_hash(pixel ^ pcg_hash(seed))
+            } else {
+                0
+            },
             index_reversed: index.reverse_bits(),
             dimension: 0,
-            rng_state: if sobol { 0 } else { rng_init(pixel, index, seed) },
+            rng_state: if sobol {
+                0
+            } else {
+                rng_init(pixel, index, seed)
+            },
         }
     }
 

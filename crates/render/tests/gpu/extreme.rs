@@ -7,8 +7,8 @@
 use pathlight_core::{GpuScene, SceneSource, load_scene};
 use pathlight_cpu::CpuRenderer;
 use pathlight_cpu::integrator::trace_path;
-use pathlight_cpu::scene::CpuScene;
 use pathlight_cpu::sampler::Sampler;
+use pathlight_cpu::scene::CpuScene;
 
 use crate::common::render;
 
