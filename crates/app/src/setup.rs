@@ -2,13 +2,14 @@
 //! open the backend that will render it.
 
 use anyhow::{Context, anyhow};
+use pathlight_core::gpu::{SAMPLER_INDEPENDENT, SAMPLER_SOBOL};
 use pathlight_core::load::{check_max_depth, check_resolution};
 use pathlight_core::{Film, GpuScene, Scene, default_scene, load_scene_file};
 use pathlight_cpu::CpuRenderer;
 use pathlight_render::context::describe;
 use pathlight_render::{Accel, GpuContext, ProgressiveRenderer};
 
-use crate::cli::{Backend, DeviceArgs, SceneArgs};
+use crate::cli::{Backend, DeviceArgs, SamplerChoice, SceneArgs};
 
 /// Loads the scene named on the command line (or the default scene) with its overrides
 /// applied, refusing bad values.
@@ -30,6 +31,12 @@ pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Scene> {
     check_max_depth(scene.settings.max_depth).map_err(|m| anyhow!(m))?;
     if let Some(seed) = args.seed {
         scene.settings.seed = seed;
+    }
+    if let Some(sampler) = args.sampler {
+        scene.settings.sampler = match sampler {
+            SamplerChoice::Sobol => SAMPLER_SOBOL,
+            SamplerChoice::Independent => SAMPLER_INDEPENDENT,
+        };
     }
     Ok(scene)
 }

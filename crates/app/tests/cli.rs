@@ -316,3 +316,39 @@ fn bench_and_view_refuse_bad_options() {
         assert!(err.contains("positive finite number"), "{strength}:\n{err}");
     }
 }
+
+/// `--sampler` replaces the scene's sampler: `sobol` (the default) gives the image the scene
+/// gives, bit for bit; `independent` another one.
+#[test]
+fn sampler_option_overrides_the_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = |sampler: Option<&str>| {
+        let out = dir
+            .path()
+            .join(format!("{}.exr", sampler.unwrap_or("scene")));
+        let mut args = vec![
+            "render",
+            "--backend",
+            "cpu",
+            "--width",
+            "16",
+            "--height",
+            "16",
+        ];
+        args.extend(["--spp", "4", "-o", out.to_str().unwrap()]);
+        args.extend(sampler.map(|s| ["--sampler", s]).into_iter().flatten());
+        let output = pathlight(&args);
+        assert!(output.status.success(), "{}", stderr(&output));
+        pathlight_core::Film::read_exr(&out).unwrap().pixels
+    };
+    let scene = render(None);
+    assert_eq!(render(Some("sobol")), scene);
+    assert_ne!(render(Some("independent")), scene);
+    let output = pathlight(&["render", "--sampler", "halton"]);
+    let err = stderr(&output);
+    assert_eq!(output.status.code(), Some(2), "clap's usage error\n{err}");
+    assert!(
+        err.contains("'halton'") && err.contains("sobol, independent"),
+        "{err}"
+    );
+}

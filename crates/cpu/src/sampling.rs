@@ -113,7 +113,9 @@ mod tests {
             let turns = i as f32 / (1u32 << 20) as f32;
             let (sin, cos) = sin_cos_turns(turns);
             let (s, c) = (f64::from(turns) * std::f64::consts::TAU).sin_cos();
-            worst = worst.max((f64::from(sin) - s).abs()).max((f64::from(cos) - c).abs());
+            worst = worst
+                .max((f64::from(sin) - s).abs())
+                .max((f64::from(cos) - c).abs());
         }
         assert!(worst < 1.5e-7, "largest error {worst:e}");
         assert_eq!(sin_cos_turns(1.0), (0.0, 1.0));
