@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # Times pathlight and Mitsuba 3 on the same machine, in one run: cornell-spheres at 512x512,
 # 64 spp, the scene's max_depth. pathlight: whole-process time of `pathlight render` (CPU
-# backend, and the GPU backend on whatever adapter is found). Mitsuba: render time alone
-# (llvm_ad_rgb, after one untimed render that compiles its kernels), median of 3.
+# backend with its default Sobol sampler and with the independent sampler Mitsuba uses here,
+# and the GPU backend on whatever adapter is found). Mitsuba: render time alone (llvm_ad_rgb,
+# after one untimed render that compiles its kernels), median of 3. Quality: each image's
+# relMSE against the stored converged reference (scenes/refs/images), the same measure as
+# the reference tests.
 #
 # Installs what it needs: Debian's libllvm19 and python3-venv (apt-get, as root or with
 # sudo), then Mitsuba and NumPy from pip into a virtual environment (MITSUBA_VENV, default
@@ -29,27 +32,45 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 echo "load: $(cut -d' ' -f1-3 /proc/loadavg) (a busy machine halves both sides)"
 
-# Whole-process wall time of one pathlight render, in seconds.
+# Whole-process wall time of one pathlight render into $out/$1.exr, in seconds.
 time_pathlight() {
-    local start end
+    local image=$1 start end
+    shift
     start=$(date +%s.%N)
     ./target/release/pathlight render "scenes/refs/$SCENE.toml" --width $RES --height $RES \
-        --spp $SPP -o "$out/pathlight.exr" "$@" 2>"$out/log" || { cat "$out/log"; exit 1; }
+        --spp $SPP -o "$out/$image.exr" "$@" 2>"$out/log" || { cat "$out/log"; exit 1; }
     end=$(date +%s.%N)
     awk "BEGIN { print $end - $start }"
 }
 
 samples=$((RES * RES * SPP))
-cpu_s=$(time_pathlight --backend cpu)
-mitsuba_json=$("$VENV/bin/python" tools/mitsuba_refs.py time $SCENE --res $RES --spp $SPP)
-mitsuba_s=$(echo "$mitsuba_json" | "$VENV/bin/python" -c 'import json,sys; print(json.load(sys.stdin)["median_seconds"])')
-
-printf '%-34s %10s %14s\n' "$SCENE ${RES}x${RES}, $SPP spp" "seconds" "M samples/s"
-printf '%-34s %10.2f %14.2f\n' "pathlight --backend cpu (process)" "$cpu_s" "$(awk "BEGIN { print $samples / $cpu_s / 1e6 }")"
+cpu_s=$(time_pathlight sobol --backend cpu)
+cpu_ind_s=$(time_pathlight independent --backend cpu --sampler independent)
 if [ "${1:-}" != "--skip-gpu" ]; then
-    gpu_s=$(time_pathlight --backend gpu)
+    gpu_s=$(time_pathlight gpu --backend gpu)
     adapter=$(grep -o 'adapter: .*' "$out/log" | head -1)
-    printf '%-34s %10.2f %14.2f   (%s)\n' "pathlight --backend gpu (process)" "$gpu_s" "$(awk "BEGIN { print $samples / $gpu_s / 1e6 }")" "$adapter"
 fi
-printf '%-34s %10.2f %14.2f\n' "Mitsuba 3 llvm_ad_rgb (render)" "$mitsuba_s" "$(awk "BEGIN { print $samples / $mitsuba_s / 1e6 }")"
-printf 'pathlight cpu / Mitsuba samples/s: %.2f\n' "$(awk "BEGIN { print $mitsuba_s / $cpu_s }")"
+mitsuba_json=$("$VENV/bin/python" tools/mitsuba_refs.py time $SCENE --res $RES --spp $SPP \
+    --save "$out/mitsuba.exr")
+mitsuba_s=$(echo "$mitsuba_json" | "$VENV/bin/python" -c 'import json,sys; print(json.load(sys.stdin)["median_seconds"])')
+# Quality: relMSE of each image against the converged reference (its 256x256 box average).
+relmse_json=$("$VENV/bin/python" tools/mitsuba_refs.py relmse-of $SCENE "$out"/*.exr)
+relmse() {
+    echo "$relmse_json" | "$VENV/bin/python" -c '
+import json, sys
+print(next(r["relmse"] for r in map(json.loads, sys.stdin) if r["image"].endswith("/" + sys.argv[1])))' "$1.exr"
+}
+
+row() { # label seconds image
+    printf '%-48s %8.2f %12.2f %10.5f\n' "$1" "$2" "$(awk "BEGIN { print $samples / $2 / 1e6 }")" "$(relmse "$3")"
+}
+printf '%-48s %8s %12s %10s\n' "$SCENE ${RES}x${RES}, $SPP spp, max_depth 8" "seconds" "M samples/s" "relMSE"
+row "pathlight --backend cpu, Sobol (process)" "$cpu_s" sobol
+row "pathlight --backend cpu, independent (process)" "$cpu_ind_s" independent
+if [ -n "${gpu_s:-}" ]; then
+    row "pathlight --backend gpu, Sobol (process)" "$gpu_s" gpu
+    echo "    ($adapter)"
+fi
+row "Mitsuba 3 llvm_ad_rgb, independent (render)" "$mitsuba_s" mitsuba
+printf 'pathlight cpu / Mitsuba samples/s: %.2f (Sobol, the default), %.2f (independent, as Mitsuba)\n' \
+    "$(awk "BEGIN { print $mitsuba_s / $cpu_s }")" "$(awk "BEGIN { print $mitsuba_s / $cpu_ind_s }")"

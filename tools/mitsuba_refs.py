@@ -13,10 +13,13 @@ constant environment) to a Mitsuba scene and either
                                          prints Mitsuba's own relMSE against the stored
                                          reference: mean over pixels and channels of
                                          (test - ref)^2 / (ref^2 + 0.01), ref box-downsampled
-  time NAME... [--res 512] [--spp 64] [--repeats 3]
+  time NAME... [--res 512] [--spp 64] [--repeats 3] [--save FILE.exr]
                                          render time alone (after one untimed render that
                                          compiles the kernels), median of the repeats, and
-                                         samples/s
+                                         samples/s; --save writes the last timed image
+  relmse-of NAME FILE.exr...             prints the relMSE of each image (pathlight's or
+                                         Mitsuba's) against the stored reference, the image
+                                         box-downsampled to the reference's size
 
 Needs: pip install mitsuba numpy; apt-get install libllvm19 (for llvm_ad_rgb, the default
 variant; DRJIT_LIBLLVM_PATH is set to Debian's libLLVM.so.19.1 when it exists).
@@ -148,16 +151,25 @@ def downsample(image, size):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("command", choices=["render", "relmse", "time"])
+    ap.add_argument("command", choices=["render", "relmse", "time", "relmse-of"])
     ap.add_argument("names", nargs="+")
     ap.add_argument("--res", type=int)
     ap.add_argument("--spp", type=int)
     ap.add_argument("--seeds", type=int, default=8)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--variant", default="llvm_ad_rgb")
+    ap.add_argument("--save")
     a = ap.parse_args()
     import mitsuba as mi
     mi.set_variant(a.variant)
+    if a.command == "relmse-of":
+        name, files = a.names[0], a.names[1:]
+        ref = np.asarray(mi.Bitmap(os.path.join(REFS, "images", name + ".exr")), np.float64)[..., :3]
+        for f in files:
+            img = downsample(np.asarray(mi.Bitmap(f), np.float64)[..., :3], ref.shape[0])
+            value = float(np.mean((img - ref) ** 2 / (ref ** 2 + 0.01)))
+            print(json.dumps({"scene": name, "image": f, "relmse": round(value, 6)}), flush=True)
+        return
     for name in a.names:
         scene = load(name)
         if a.command == "render":
@@ -179,8 +191,10 @@ def main():
             times = []
             for seed in range(1, a.repeats + 1):
                 t0 = time.perf_counter()
-                np.asarray(mi.render(mts, spp=spp, seed=seed))
+                img = np.asarray(mi.render(mts, spp=spp, seed=seed))
                 times.append(time.perf_counter() - t0)
+            if a.save:
+                mi.Bitmap(img[..., :3].astype(np.float32), mi.Bitmap.PixelFormat.RGB).write(a.save)
             seconds = float(np.median(times))
             print(json.dumps({"scene": name, "variant": a.variant, "res": res, "spp": spp,
                               "seconds": [round(t, 3) for t in times], "median_seconds": round(seconds, 3),
