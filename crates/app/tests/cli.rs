@@ -35,21 +35,22 @@ fn fails_with(args: &[&str], needles: &[&str]) -> String {
     err
 }
 
+/// A 16x16 CPU render of the default scene: the arguments before `--spp` and `-o`.
+const SMALL_CPU_RENDER: [&str; 7] = [
+    "render",
+    "--backend",
+    "cpu",
+    "--width",
+    "16",
+    "--height",
+    "16",
+];
+
 /// Starts a 16x16 CPU render of the default scene at `spp` into `out`, stderr piped.
 fn spawn_cpu_render(spp: &str, out: &Path) -> std::process::Child {
     Command::new(env!("CARGO_BIN_EXE_pathlight"))
-        .args([
-            "render",
-            "--backend",
-            "cpu",
-            "--width",
-            "16",
-            "--height",
-            "16",
-            "--spp",
-            spp,
-            "-o",
-        ])
+        .args(SMALL_CPU_RENDER)
+        .args(["--spp", spp, "-o"])
         .arg(out)
         .stderr(std::process::Stdio::piped())
         .spawn()
@@ -326,15 +327,7 @@ fn sampler_option_overrides_the_scene() {
         let out = dir
             .path()
             .join(format!("{}.exr", sampler.unwrap_or("scene")));
-        let mut args = vec![
-            "render",
-            "--backend",
-            "cpu",
-            "--width",
-            "16",
-            "--height",
-            "16",
-        ];
+        let mut args = SMALL_CPU_RENDER.to_vec();
         args.extend(["--spp", "4", "-o", out.to_str().unwrap()]);
         args.extend(sampler.map(|s| ["--sampler", s]).into_iter().flatten());
         let output = pathlight(&args);
