@@ -64,7 +64,8 @@ print(next(r["relmse"] for r in map(json.loads, sys.stdin) if r["image"].endswit
 row() { # label seconds image
     printf '%-48s %8.2f %12.2f %10.5f\n' "$1" "$2" "$(awk "BEGIN { print $samples / $2 / 1e6 }")" "$(relmse "$3")"
 }
-printf '%-48s %8s %12s %10s\n' "$SCENE ${RES}x${RES}, $SPP spp, max_depth 8" "seconds" "M samples/s" "relMSE"
+max_depth=$(sed -n 's/^max_depth *= *//p' "scenes/refs/$SCENE.toml")
+printf '%-48s %8s %12s %10s\n' "$SCENE ${RES}x${RES}, $SPP spp, max_depth $max_depth" "seconds" "M samples/s" "relMSE"
 row "pathlight --backend cpu, Sobol (process)" "$cpu_s" sobol
 row "pathlight --backend cpu, independent (process)" "$cpu_ind_s" independent
 if [ -n "${gpu_s:-}" ]; then

@@ -35,21 +35,14 @@ fn fails_with(args: &[&str], needles: &[&str]) -> String {
     err
 }
 
-/// A 16x16 CPU render of the default scene: the arguments before `--spp` and `-o`.
-const SMALL_CPU_RENDER: [&str; 7] = [
-    "render",
-    "--backend",
-    "cpu",
-    "--width",
-    "16",
-    "--height",
-    "16",
-];
+/// The options of a 16x16 image on the CPU backend (for `render` and `bench`).
+const SMALL_ON_CPU: [&str; 6] = ["--backend", "cpu", "--width", "16", "--height", "16"];
 
 /// Starts a 16x16 CPU render of the default scene at `spp` into `out`, stderr piped.
 fn spawn_cpu_render(spp: &str, out: &Path) -> std::process::Child {
     Command::new(env!("CARGO_BIN_EXE_pathlight"))
-        .args(SMALL_CPU_RENDER)
+        .arg("render")
+        .args(SMALL_ON_CPU)
         .args(["--spp", spp, "-o"])
         .arg(out)
         .stderr(std::process::Stdio::piped())
@@ -245,20 +238,9 @@ fn viewer_without_a_display_suggests_render() {
 /// `pathlight bench --json` (CPU backend, so it runs anywhere): the figures hang together.
 #[test]
 fn bench_reports_consistent_figures_as_json() {
-    let args = [
-        "bench",
-        "--backend",
-        "cpu",
-        "--width",
-        "16",
-        "--height",
-        "16",
-        "--frames",
-        "3",
-        "--warmup",
-        "1",
-        "--json",
-    ];
+    let mut args = vec!["bench"];
+    args.extend(SMALL_ON_CPU);
+    args.extend(["--frames", "3", "--warmup", "1", "--json"]);
     let output = pathlight(&args);
     assert!(output.status.success(), "{}", stderr(&output));
     let report: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
@@ -327,7 +309,8 @@ fn sampler_option_overrides_the_scene() {
         let out = dir
             .path()
             .join(format!("{}.exr", sampler.unwrap_or("scene")));
-        let mut args = SMALL_CPU_RENDER.to_vec();
+        let mut args = vec!["render"];
+        args.extend(SMALL_ON_CPU);
         args.extend(["--spp", "4", "-o", out.to_str().unwrap()]);
         args.extend(sampler.map(|s| ["--sampler", s]).into_iter().flatten());
         let output = pathlight(&args);

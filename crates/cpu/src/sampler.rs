@@ -97,22 +97,12 @@ impl Sampler {
     /// Sample `index` of `pixel` under `seed`, of kind `SAMPLER_*`. Twin of WGSL `sampler_init`.
     #[inline(always)]
     pub fn new(kind: u32, pixel: u32, index: u32, seed: u32) -> Self {
-        // Each kind hashes only the seed it uses.
-        let sobol = kind == SAMPLER_SOBOL;
         Self {
             kind,
-            pixel_seed: if sobol {
-                pcg_hash(pixel ^ pcg_hash(seed))
-            } else {
-                0
-            },
+            pixel_seed: pcg_hash(pixel ^ pcg_hash(seed)),
             index_reversed: index.reverse_bits(),
             dimension: 0,
-            rng_state: if sobol {
-                0
-            } else {
-                rng_init(pixel, index, seed)
-            },
+            rng_state: rng_init(pixel, index, seed),
         }
     }
 
@@ -124,18 +114,6 @@ impl Sampler {
         let s = self.rng_state;
         let word = ((s >> ((s >> 28) + 4)) ^ s).wrapping_mul(277_803_737);
         to_unit_float((word >> 22) ^ word)
-    }
-
-    /// The scrambled Sobol point (both coordinates, as 32-bit fractions) of the dimension
-    /// whose number hashes to `dimension_hash`.
-    #[inline(always)]
-    fn sobol_point(&self, dimension_hash: u32) -> (u32, u32) {
-        let seed = pcg_hash(self.pixel_seed ^ dimension_hash);
-        let index = owen_scramble_reversed(self.index_reversed, seed);
-        (
-            owen_scramble_reversed(index, pcg_hash(seed ^ 1)),
-            owen_scramble_reversed(sobol_1_reversed(index), pcg_hash(seed ^ 2)),
-        )
     }
 
     /// The next value in [0, 1). Twin of WGSL `next_1d`.
@@ -188,7 +166,10 @@ impl Sampler {
         self.dimension += N as u32;
         let (mut x, mut y) = ([0u32; LANES], [0u32; LANES]);
         for i in 0..LANES {
-            (x[i], y[i]) = self.sobol_point(hashes[i]);
+            let seed = pcg_hash(self.pixel_seed ^ hashes[i]);
+            let index = owen_scramble_reversed(self.index_reversed, seed);
+            x[i] = owen_scramble_reversed(index, pcg_hash(seed ^ 1));
+            y[i] = owen_scramble_reversed(sobol_1_reversed(index), pcg_hash(seed ^ 2));
         }
         for i in 0..N {
             out[i].x = to_unit_float(x[i]);
