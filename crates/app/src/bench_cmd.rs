@@ -34,8 +34,9 @@ struct Measurement {
     height: u32,
     max_depth: u32,
     triangles: usize,
-    /// Entries of the traversal stack the scene needs (the integrator is compiled with it).
-    traversal_stack: u32,
+    /// Entries of the GPU's traversal stack (the integrator is compiled with it: the scene's
+    /// bound rounded up to 8); none on the CPU backend.
+    traversal_stack: Option<u32>,
     /// Seconds to build the BVH (both levels).
     bvh_build_s: f64,
     /// Seconds from the start of this configuration (the command's start for the first:
@@ -141,8 +142,8 @@ fn measure(
     let gpu_scene = GpuScene::build(scene);
     let bvh_build_s = build_start.elapsed().as_secs_f64();
     let triangles = gpu_scene.vertices.len() / 3;
-    let traversal_stack = gpu_scene.traversal_stack_bound();
     let mut renderer = Renderer::new(ctx, scene, gpu_scene, accel)?;
+    let traversal_stack = renderer.traversal_stack();
     let time_limit = Duration::from_secs_f64(args.time_limit.max(0.0));
 
     // The first frame is never timed: it includes the pipeline's first use.
@@ -228,9 +229,12 @@ fn print_single(report: &Report) {
         m.rays_per_s / 1e6,
         m.rays_per_sample
     );
+    let stack = m
+        .traversal_stack
+        .map_or(String::new(), |entries| format!(", stack {entries}"));
     println!(
-        "first frame  {:.3} s after start (BVH build {:.3} s, {} triangles, stack {})",
-        m.first_frame_s, m.bvh_build_s, m.triangles, m.traversal_stack
+        "first frame  {:.3} s after start (BVH build {:.3} s, {} triangles{stack})",
+        m.first_frame_s, m.bvh_build_s, m.triangles
     );
 }
 

@@ -128,6 +128,15 @@ impl Renderer {
         Ok(())
     }
 
+    /// Entries of the GPU's traversal stack (the integrator is compiled with it); `None` on
+    /// the CPU backend, whose stacks grow as needed.
+    pub fn traversal_stack(&self) -> Option<u32> {
+        match self {
+            Self::Gpu(r) => Some(r.stack_size()),
+            Self::Cpu(_) => None,
+        }
+    }
+
     /// Rays traced so far.
     pub fn rays_traced(&self) -> anyhow::Result<u64> {
         Ok(match self {

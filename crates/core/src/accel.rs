@@ -1,5 +1,7 @@
 //! Acceleration structure: a BLAS per mesh and a top level over all objects, flattened into
-//! the buffers the WGSL traversal (`bvh.wgsl`) and its CPU twin ([`crate::trace`]) read.
+//! the buffers the GPU reads; the binary trees are collapsed into 4-wide ones
+//! ([`crate::WideBvh`]) for both backends and walked as they are by the viewer's picking
+//! ([`crate::trace`]).
 //!
 //! Both levels are obvhs BVH2s (PLOC build, reinsertion, SAH-driven leaf collapse), laid out
 //! in one node array: the top level first (root at 0), then each BLAS with its indices
@@ -25,7 +27,8 @@ use crate::scene::{Object, Scene, Shape, TriangleMesh};
 /// The scene in the form the GPU reads it.
 #[derive(Debug, Clone, Default)]
 pub struct GpuScene {
-    /// Top level at 0, then every BLAS. Never empty (a placeholder when there are no objects).
+    /// The binary trees: top level at 0, then every BLAS. Never empty (a placeholder when
+    /// there are no objects). The GPU reads their 4-wide form, [`crate::WideBvh`].
     pub nodes: Vec<GpuBvhNode>,
     /// Objects in top-level leaf order.
     pub objects: Vec<GpuObject>,
@@ -344,49 +347,6 @@ impl GpuScene {
         if self.lights.is_empty() {
             self.lights.push(GpuLight::zeroed());
         }
-    }
-
-    /// Most entries the traversal stack of WGSL `trace_scene` can hold at once for this
-    /// scene: one pending sibling per level of the top level, the meshes of one top-level
-    /// leaf (with the marker that replaces one of them), and one pending sibling per level
-    /// of the deepest BLAS. The integrator's stack is sized from it.
-    pub fn traversal_stack_bound(&self) -> u32 {
-        if self.object_count == 0 {
-            return 1;
-        }
-        let (top_depth, leaves) = self.depth_and_leaves(0);
-        let meshes_per_leaf = leaves
-            .iter()
-            .map(|node| {
-                (node.first_index..node.first_index + node.prim_count)
-                    .filter(|&i| self.objects[i as usize].kind == KIND_MESH)
-                    .count() as u32
-            })
-            .max()
-            .unwrap_or(0);
-        let blas_depth = self.objects[..self.object_count as usize]
-            .iter()
-            .filter(|o| o.kind == KIND_MESH)
-            .map(|o| self.depth_and_leaves(o.blas_root).0)
-            .max()
-            .unwrap_or(0);
-        top_depth + meshes_per_leaf + blas_depth + 1
-    }
-
-    /// Depth in edges of the tree rooted at `root`, and its leaves.
-    fn depth_and_leaves(&self, root: u32) -> (u32, Vec<GpuBvhNode>) {
-        let (mut depth, mut leaves) = (0, Vec::new());
-        let mut stack = vec![(root, 0)];
-        while let Some((i, d)) = stack.pop() {
-            let node = self.nodes[i as usize];
-            depth = depth.max(d);
-            if node.prim_count == 0 {
-                stack.extend([(node.first_index, d + 1), (node.first_index + 1, d + 1)]);
-            } else {
-                leaves.push(node);
-            }
-        }
-        (depth, leaves)
     }
 
     /// Appends a mesh's BLAS and triangles; returns the BLAS root's node index.

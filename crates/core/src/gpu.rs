@@ -2,7 +2,7 @@
 //!
 //! Every struct is `#[repr(C)]` + `Pod`, uses no `vec3` without the scalar that pads it to
 //! 16 bytes, and is pinned in size here and in field offsets by a naga test in
-//! `crates/render/tests/layout.rs`.
+//! `crates/render/tests/shaders.rs`.
 
 use bytemuck::{Pod, Zeroable};
 
@@ -46,7 +46,8 @@ pub struct GpuObject {
     pub kind: u32,
     /// Index into the material buffer.
     pub material: u32,
-    /// Mesh only: index of the BLAS root in the node buffer.
+    /// Mesh only: index of the BLAS root in the node buffer ([`crate::GpuScene::nodes`]; on
+    /// the device, in the 4-wide nodes: [`crate::WideBvh::gpu_objects`]).
     pub blas_root: u32,
     /// Index of the object in [`crate::Scene::objects`] (the top level reorders objects).
     pub id: u32,
@@ -79,7 +80,9 @@ pub struct GpuLight {
 }
 const _: () = assert!(size_of::<GpuLight>() == 16);
 
-/// One BVH2 node in the layout of `obvhs::bvh2::node::Bvh2Node`. WGSL: `BvhNode`.
+/// One BVH2 node in the layout of `obvhs::bvh2::node::Bvh2Node`: the binary trees of
+/// [`crate::GpuScene`], which [`crate::WideBvh`] collapses into the 4-wide ones both backends
+/// walk (the GPU reads [`GpuWideNode`]s, not these).
 ///
 /// If `prim_count` is 0 this is an inner node whose children are `first_index` and
 /// `first_index + 1`; otherwise it is a leaf holding primitives
@@ -103,6 +106,31 @@ pub struct GpuBvhNode {
     pub pad2: [u32; 2],
 }
 const _: () = assert!(size_of::<GpuBvhNode>() == 48);
+
+/// One node of the 4-wide BVH the GPU walks ([`crate::WideBvh`]): its four children's boxes
+/// in structure-of-arrays form, and what each child is. WGSL: `WideNode`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuWideNode {
+    /// The children's minimum x coordinates; an unused child has an inverted box
+    /// (+inf to -inf) that no ray enters.
+    pub lo_x: [f32; 4],
+    /// The children's minimum y coordinates.
+    pub lo_y: [f32; 4],
+    /// The children's minimum z coordinates.
+    pub lo_z: [f32; 4],
+    /// The children's maximum x coordinates.
+    pub hi_x: [f32; 4],
+    /// The children's maximum y coordinates.
+    pub hi_y: [f32; 4],
+    /// The children's maximum z coordinates.
+    pub hi_z: [f32; 4],
+    /// Per child: an inner node's index, or a leaf's first primitive.
+    pub first: [u32; 4],
+    /// Per child: a leaf's number of primitives; 0 for an inner node or an unused child.
+    pub count: [u32; 4],
+}
+const _: () = assert!(size_of::<GpuWideNode>() == 128);
 
 /// One triangle corner. WGSL: `Vertex`; a triangle is three consecutive vertices.
 #[repr(C)]

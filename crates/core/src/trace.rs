@@ -1,5 +1,6 @@
-//! Ray queries on a [`GpuScene`] on the CPU: the twin of `intersect.wgsl` and `bvh.wgsl`
-//! (same names, same arithmetic), used to check the GPU traversal and for picking.
+//! Ray queries on a [`GpuScene`] on the CPU: the twin of `intersect.wgsl` and of the
+//! primitive tests of `bvh.wgsl` (same names, same arithmetic), and a walk of the binary
+//! trees, used for picking and as the reference the 4-wide walks are checked against.
 
 use glam::{Vec3, Vec3A};
 
@@ -46,7 +47,7 @@ impl Hit {
     }
 }
 
-/// Slab test; twin of WGSL `intersect_aabb`. Returns the entry distance or [`MISS`].
+/// Slab test on a binary node's box; twin of WGSL `intersect_aabb`. Returns the entry distance or [`MISS`].
 ///
 /// In SIMD lanes (`Vec3A`): its min and max skip the NaN handling of `f32::min`, which cost a
 /// fifth of the traversal; no NaN can arise (`inv_dir` is finite, see [`safe_inverse`]), and
@@ -271,7 +272,7 @@ impl GpuScene {
     }
 
     /// Nearest hit in `(0, t_max)`, or with `any_hit` the first one found: one ordered
-    /// stack walk over both levels. Twin of WGSL `trace_scene` (its BVH scheme).
+    /// stack walk over both levels of the binary trees.
     fn trace(&self, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
         let mut hit = Hit::none(t_max);
         let nodes = &self.nodes;
@@ -279,7 +280,6 @@ impl GpuScene {
         if self.object_count == 0 || intersect_aabb(&nodes[0], ray.origin, inv_dir, hit.t) == MISS {
             return hit;
         }
-        // WGSL sizes its stack by `traversal_stack_bound`; here it grows as needed.
         let mut stack: Vec<(Entry, f32)> = Vec::with_capacity(64);
         let mut index = 0u32;
         // The mesh whose BLAS is being walked, if any.

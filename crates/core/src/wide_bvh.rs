@@ -1,5 +1,6 @@
-//! The CPU's acceleration structure: [`GpuScene`]'s binary BVHs collapsed into 4-wide ones,
-//! whose four child boxes are tested at once in SIMD lanes (glam's `Vec4`: SSE on x86-64).
+//! The acceleration structure both backends walk: [`GpuScene`]'s binary BVHs collapsed into
+//! 4-wide ones, whose four child boxes are tested at once (in SIMD lanes on the CPU, glam's
+//! `Vec4`; as `vec4f`s by WGSL `trace_scene` in `bvh.wgsl`, which reads [`GpuWideNode`]s).
 //!
 //! A ray visits about half as many nodes as in the binary tree and tests their children in
 //! one go. The primitive tests are [`crate::trace`]'s, the WGSL twins, so hits are the same;
@@ -8,11 +9,12 @@
 
 use std::ops::Range;
 
+use bytemuck::Zeroable;
 use glam::{Vec3, Vec4};
 use obvhs::aabb::Aabb;
 
 use crate::accel::GpuScene;
-use crate::gpu::{GpuBvhNode, KIND_MESH};
+use crate::gpu::{GpuBvhNode, GpuObject, GpuWideNode, KIND_MESH};
 use crate::packet::Lanes;
 use crate::trace::{Hit, Ray, intersect_triangle_edges, safe_inverse};
 
@@ -123,6 +125,84 @@ impl WideBvh {
             })
             .collect();
         bvh
+    }
+
+    /// The nodes in the layout the GPU reads. Never empty (a placeholder when there are no
+    /// objects).
+    pub fn gpu_nodes(&self) -> Vec<GpuWideNode> {
+        if self.nodes.is_empty() {
+            return vec![GpuWideNode::zeroed()];
+        }
+        self.nodes
+            .iter()
+            .map(|n| GpuWideNode {
+                lo_x: n.lo[0].to_array(),
+                lo_y: n.lo[1].to_array(),
+                lo_z: n.lo[2].to_array(),
+                hi_x: n.hi[0].to_array(),
+                hi_y: n.hi[1].to_array(),
+                hi_z: n.hi[2].to_array(),
+                first: n.first,
+                count: n.count,
+            })
+            .collect()
+    }
+
+    /// `scene`'s objects as the GPU reads them: a mesh's `blas_root` is the root of its tree
+    /// here instead of in the binary nodes.
+    pub fn gpu_objects(&self, scene: &GpuScene) -> Vec<GpuObject> {
+        scene
+            .objects
+            .iter()
+            .zip(&self.mesh_roots)
+            .map(|(o, &root)| GpuObject {
+                blas_root: if o.kind == KIND_MESH { root } else { 0 },
+                ..*o
+            })
+            .collect()
+    }
+
+    /// Most entries the traversal stack of WGSL `trace_scene` can hold at once for `scene`
+    /// (from which this tree was built). The walk pushes, at each node, the entered inner
+    /// children but the nearest and the meshes of the entered leaves, and keeps only the
+    /// pending entries of the current node's ancestors; a mesh's tree is walked above the
+    /// marker that replaces its entry. The integrator's stack is sized from it.
+    pub fn stack_bound(&self, scene: &GpuScene) -> u32 {
+        if !self.has_objects {
+            return 1;
+        }
+        let top = self.path_pushes(0, &|first, count| {
+            (first..first + count)
+                .filter(|&i| scene.objects[i as usize].kind == KIND_MESH)
+                .count() as u32
+        });
+        let mesh = scene.objects[..scene.object_count as usize]
+            .iter()
+            .zip(&self.mesh_roots)
+            .filter(|(o, _)| o.kind == KIND_MESH)
+            .map(|(_, &root)| self.path_pushes(root, &|_, _| 0))
+            .max()
+            .unwrap_or(0);
+        top + mesh + 1
+    }
+
+    /// Most entries pushed along one path down from `node`, where a leaf of `count`
+    /// primitives from `first` pushes `leaf_pushes(first, count)`.
+    fn path_pushes(&self, node: u32, leaf_pushes: &dyn Fn(u32, u32) -> u32) -> u32 {
+        let n = &self.nodes[node as usize];
+        let used = (0..4).filter(|&lane| n.lo[0][lane] <= n.hi[0][lane]);
+        let (inner, leaves): (Vec<usize>, Vec<usize>) = used.partition(|&lane| n.count[lane] == 0);
+        let at_node = leaves
+            .iter()
+            .map(|&lane| leaf_pushes(n.first[lane], n.count[lane]))
+            .sum::<u32>()
+            + (inner.len() as u32).saturating_sub(1);
+        let below = inner
+            .iter()
+            .map(|&lane| self.path_pushes(n.first[lane], leaf_pushes))
+            .max()
+            .unwrap_or(0);
+        at_node + below
     }
 
     /// Appends the 4-wide form of the binary subtree at `root`; returns its node index.

@@ -1,10 +1,13 @@
-// Two-level BVH traversal: the top level over objects, a BLAS per mesh, both obvhs BVH2s in
-// `nodes` (see `crates/core/src/accel.rs`). Ordered depth-first with one explicit stack for
-// both levels: the nearer child is visited first, the farther one pushed with its entry
-// distance and skipped on pop if a closer hit was found meanwhile. A mesh met in a top-level
-// leaf is pushed as an ENTER_MESH entry; popping it pushes a LEAVE_MESH marker and walks the
-// mesh's BLAS, whose entries all lie above the marker. Shadow rays stop at the first hit.
-// CPU twin: `crates/core/src/trace.rs`.
+// Two-level 4-wide BVH traversal: the top level over objects, a tree per mesh, all in
+// `nodes` (`WideNode`s collapsed from obvhs BVH2s: `crates/core/src/wide_bvh.rs`). Ordered
+// depth-first with one explicit stack for both levels. At each node the four child boxes are
+// tested at once; entered leaves are intersected at once (in the top level a mesh is pushed
+// as an ENTER_MESH entry instead), the nearest entered inner child is visited next and the
+// others are pushed with their entry distances, nearest on top, to be skipped on pop if a
+// closer hit was found meanwhile. Popping an ENTER_MESH entry pushes a LEAVE_MESH marker and
+// walks the mesh's tree, whose entries all lie above the marker. Shadow rays stop at the
+// first hit. CPU twin: `Walk::tree` in `crates/core/src/wide_bvh.rs` (which visits leaves
+// nearest first; the hits are the same).
 //
 // `ACCEL` (a pipeline constant) selects the seed's slower schemes for benchmarks: every object
 // in turn, a mesh's triangles tested only when the ray hits the mesh's bounding box
@@ -17,8 +20,8 @@ override ACCEL: u32 = 0u;
 
 const STACK_SIZE: u32 = 64u;
 const NO_HIT: u32 = 0xffffffffu;
-// Stack entry tags: an object whose BLAS is still to be walked (its index in the low bits),
-// and the end of the BLAS being walked.
+// Stack entry tags: an object whose tree is still to be walked (its index in the low bits),
+// and the end of the mesh tree being walked.
 const ENTER_MESH: u32 = 0x80000000u;
 const LEAVE_MESH: u32 = 0xffffffffu;
 // No node left to visit.
@@ -82,13 +85,55 @@ fn intersect_linear(ray: Ray, inv_dir: vec3f, object_count: u32, any_hit: bool, 
         if o.kind != KIND_MESH {
             intersect_shape(i, o, ray, hit);
         } else if ACCEL == ACCEL_BRUTE_FORCE
-            || intersect_aabb(nodes[o.blas_root], ray.origin, inv_dir, (*hit).t) != MISS {
+            || intersect_aabb(tree_bounds(nodes[o.blas_root]), ray.origin, inv_dir, (*hit).t) != MISS {
             intersect_triangles(i, o.first_triangle, o.triangle_count, ray, hit);
         }
         if any_hit && (*hit).object != NO_HIT {
             return;
         }
     }
+}
+
+// Box around the four children of `n` (the bounds of the tree it is the root of).
+fn tree_bounds(n: WideNode) -> Aabb {
+    let lo = vec3f(
+        min(min(n.lo_x.x, n.lo_x.y), min(n.lo_x.z, n.lo_x.w)),
+        min(min(n.lo_y.x, n.lo_y.y), min(n.lo_y.z, n.lo_y.w)),
+        min(min(n.lo_z.x, n.lo_z.y), min(n.lo_z.z, n.lo_z.w)),
+    );
+    let hi = vec3f(
+        max(max(n.hi_x.x, n.hi_x.y), max(n.hi_x.z, n.hi_x.w)),
+        max(max(n.hi_y.x, n.hi_y.y), max(n.hi_y.z, n.hi_y.w)),
+        max(max(n.hi_z.x, n.hi_z.y), max(n.hi_z.z, n.hi_z.w)),
+    );
+    return Aabb(lo, hi);
+}
+
+// Entry distances (clamped at 0) of the four child boxes of `n`, MISS for those the ray does
+// not enter before t_max. Per axis the near plane is the minimum one unless the ray runs
+// backwards (`backwards`), so an unused child's inverted box is never entered. Twin of
+// `RayLanes::enter`.
+fn enter_children(n: WideNode, origin: vec3f, inv_dir: vec3f, backwards: vec3<bool>, t_max: f32) -> vec4f {
+    let near_x = (select(n.lo_x, n.hi_x, backwards.x) - origin.x) * inv_dir.x;
+    let far_x = (select(n.hi_x, n.lo_x, backwards.x) - origin.x) * inv_dir.x;
+    let near_y = (select(n.lo_y, n.hi_y, backwards.y) - origin.y) * inv_dir.y;
+    let far_y = (select(n.hi_y, n.lo_y, backwards.y) - origin.y) * inv_dir.y;
+    let near_z = (select(n.lo_z, n.hi_z, backwards.z) - origin.z) * inv_dir.z;
+    let far_z = (select(n.hi_z, n.lo_z, backwards.z) - origin.z) * inv_dir.z;
+    let t_near = max(max(near_x, near_y), max(near_z, vec4f(0.0)));
+    let t_far = min(min(far_x, far_y), min(far_z, vec4f(t_max)));
+    return select(vec4f(MISS), t_near, t_near <= t_far);
+}
+
+// Orders the pairs (a, b) by key: afterwards *ka <= *kb.
+fn order_pair(ka: ptr<function, f32>, ca: ptr<function, u32>, kb: ptr<function, f32>, cb: ptr<function, u32>) {
+    let swap = *kb < *ka;
+    let k = *ka;
+    let c = *ca;
+    *ka = select(k, *kb, swap);
+    *ca = select(c, *cb, swap);
+    *kb = select(*kb, k, swap);
+    *cb = select(*cb, c, swap);
 }
 
 // Nearest hit in (0, t_max) over the whole scene, or with `any_hit` the first one found;
@@ -103,64 +148,78 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
         intersect_linear(ray, inv_dir, object_count, any_hit, &hit);
         return hit;
     }
-    if intersect_aabb(nodes[0], ray.origin, inv_dir, hit.t) == MISS {
-        return hit;
-    }
+    let backwards = inv_dir < vec3f(0.0);
     var stack_node: array<u32, STACK_SIZE>;
     var stack_t: array<f32, STACK_SIZE>;
     var sp = 0u;
     var index = 0u;
-    // The mesh whose BLAS is being walked, or NO_HIT in the top level.
+    // The mesh whose tree is being walked, or NO_HIT in the top level.
     var mesh = NO_HIT;
-    // "While-while" (Aila and Laine): a warp's lanes walk inner nodes together, then
-    // intersect leaves together, instead of alternating between the two each step.
     loop {
-        var node = nodes[index];
-        while node.prim_count == 0u {
-            let a = node.first_index;
-            let ta = intersect_aabb(nodes[a], ray.origin, inv_dir, hit.t);
-            let tb = intersect_aabb(nodes[a + 1u], ray.origin, inv_dir, hit.t);
-            if ta != MISS && tb != MISS {
-                let near_is_a = ta <= tb;
-                index = select(a, a + 1u, !near_is_a);
-                if sp < STACK_SIZE {
-                    stack_node[sp] = select(a + 1u, a, !near_is_a);
-                    stack_t[sp] = max(ta, tb);
-                    sp++;
-                }
-            } else if ta != MISS || tb != MISS {
-                index = select(a + 1u, a, ta != MISS);
-            } else {
-                index = pop_entry(&stack_node, &stack_t, &sp, &mesh, hit.t);
-                if index == NO_NODE {
-                    return hit;
-                }
+        let n = nodes[index];
+        let t = enter_children(n, ray.origin, inv_dir, backwards, hit.t);
+        for (var lane = 0u; lane < 4u; lane++) {
+            let count = n.count[lane];
+            if count == 0u || t[lane] >= hit.t {
+                continue;
             }
-            node = nodes[index];
-        }
-        if mesh != NO_HIT {
-            intersect_triangles(mesh, node.first_index, node.prim_count, ray, &hit);
-        } else {
-            for (var i = node.first_index; i < node.first_index + node.prim_count; i++) {
+            let first = n.first[lane];
+            if mesh != NO_HIT {
+                intersect_triangles(mesh, first, count, ray, &hit);
+                continue;
+            }
+            for (var i = first; i < first + count; i++) {
                 let o = objects[i];
                 if o.kind != KIND_MESH {
                     intersect_shape(i, o, ray, &hit);
                 } else if sp < STACK_SIZE {
-                    let t = intersect_aabb(nodes[o.blas_root], ray.origin, inv_dir, hit.t);
-                    if t != MISS {
-                        stack_node[sp] = ENTER_MESH | i;
-                        stack_t[sp] = t;
-                        sp++;
-                    }
+                    stack_node[sp] = ENTER_MESH | i;
+                    stack_t[sp] = t[lane];
+                    sp++;
                 }
             }
         }
         if any_hit && hit.object != NO_HIT {
             return hit;
         }
-        index = pop_entry(&stack_node, &stack_t, &sp, &mesh, hit.t);
-        if index == NO_NODE {
-            return hit;
+        // The entered inner children, nearest first (a sorting network on four keys; MISS
+        // for leaves and children not entered before the current hit).
+        let inner = n.count == vec4u(0u) & t < vec4f(hit.t);
+        var k0 = select(MISS, t.x, inner.x);
+        var k1 = select(MISS, t.y, inner.y);
+        var k2 = select(MISS, t.z, inner.z);
+        var k3 = select(MISS, t.w, inner.w);
+        var c0 = n.first.x;
+        var c1 = n.first.y;
+        var c2 = n.first.z;
+        var c3 = n.first.w;
+        order_pair(&k0, &c0, &k1, &c1);
+        order_pair(&k2, &c2, &k3, &c3);
+        order_pair(&k0, &c0, &k2, &c2);
+        order_pair(&k1, &c1, &k3, &c3);
+        order_pair(&k1, &c1, &k2, &c2);
+        if k0 == MISS {
+            index = pop_entry(&stack_node, &stack_t, &sp, &mesh, hit.t);
+            if index == NO_NODE {
+                return hit;
+            }
+            continue;
+        }
+        index = c0;
+        if k3 != MISS && sp < STACK_SIZE {
+            stack_node[sp] = c3;
+            stack_t[sp] = k3;
+            sp++;
+        }
+        if k2 != MISS && sp < STACK_SIZE {
+            stack_node[sp] = c2;
+            stack_t[sp] = k2;
+            sp++;
+        }
+        if k1 != MISS && sp < STACK_SIZE {
+            stack_node[sp] = c1;
+            stack_t[sp] = k1;
+            sp++;
         }
     }
     return hit;

@@ -9,10 +9,16 @@ struct Ray {
     dir: vec3f,
 }
 
+// An axis-aligned box.
+struct Aabb {
+    min: vec3f,
+    max: vec3f,
+}
+
 // Slab test; `inv_dir` has no infinities (see `safe_inverse`). Returns the entry distance.
-fn intersect_aabb(node: BvhNode, origin: vec3f, inv_dir: vec3f, t_max: f32) -> f32 {
-    let t0 = (node.aabb_min - origin) * inv_dir;
-    let t1 = (node.aabb_max - origin) * inv_dir;
+fn intersect_aabb(b: Aabb, origin: vec3f, inv_dir: vec3f, t_max: f32) -> f32 {
+    let t0 = (b.min - origin) * inv_dir;
+    let t1 = (b.max - origin) * inv_dir;
     let t_near = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
     let t_far = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), min(max(t0.z, t1.z), t_max));
     return select(MISS, t_near, t_near <= t_far);

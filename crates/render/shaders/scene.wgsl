@@ -37,17 +37,19 @@ struct Light {
     pmf: f32,
 }
 
-// obvhs' Bvh2Node: prim_count 0 = inner node (children first_index, first_index + 1),
-// else a leaf of primitives first_index .. first_index + prim_count. Host: `GpuBvhNode`.
-struct BvhNode {
-    aabb_min: vec3f,
-    pad0: u32,
-    aabb_max: vec3f,
-    pad1: u32,
-    prim_count: u32,
-    first_index: u32,
-    pad2: u32,
-    pad3: u32,
+// A node of the 4-wide BVH: its children's boxes per axis (an unused child's box is
+// inverted, +inf to -inf) and per child an inner node's index (count 0) or a leaf's
+// primitives first .. first + count (objects in the top level, triangles in a mesh's tree).
+// Host: `GpuWideNode`.
+struct WideNode {
+    lo_x: vec4f,
+    lo_y: vec4f,
+    lo_z: vec4f,
+    hi_x: vec4f,
+    hi_y: vec4f,
+    hi_z: vec4f,
+    first: vec4u,
+    count: vec4u,
 }
 
 // A triangle corner; triangle i is vertices 3i, 3i+1, 3i+2. Host: `GpuVertex`.
@@ -86,7 +88,7 @@ struct TextureInfo {
     pad: u32,
 }
 
-@group(0) @binding(0) var<storage, read> nodes: array<BvhNode>;
+@group(0) @binding(0) var<storage, read> nodes: array<WideNode>;
 @group(0) @binding(1) var<storage, read> objects: array<Object>;
 @group(0) @binding(2) var<storage, read> vertices: array<Vertex>;
 @group(0) @binding(3) var<storage, read> materials: array<Material>;

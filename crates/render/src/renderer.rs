@@ -122,7 +122,7 @@ impl ProgressiveRenderer {
                 storage_entry(2, false),
             ],
         });
-        let stack_size = stack_size(gpu_scene);
+        let stack_size = stack_size(&scene_buffers);
         let pipeline = integrator_pipeline(
             device,
             &scene_buffers.layout,
@@ -179,6 +179,11 @@ impl ProgressiveRenderer {
         self.rows_per_dispatch = rows.clamp(1, self.params.height);
         self.batch_samples = samples.clamp(1, MAX_BATCH_SAMPLES);
         self.adaptive = false;
+    }
+
+    /// Entries of the integrator's traversal stack: the scene's bound, rounded up to 8.
+    pub fn stack_size(&self) -> u32 {
+        self.stack_size
     }
 
     /// Samples per pixel accumulated so far.
@@ -279,8 +284,8 @@ impl ProgressiveRenderer {
             self.batch_samples = 1;
         }
         self.scene = SceneBuffers::upload(device, gpu_scene)?;
-        if stack_size(gpu_scene) > self.stack_size {
-            self.stack_size = stack_size(gpu_scene);
+        if stack_size(&self.scene) > self.stack_size {
+            self.stack_size = stack_size(&self.scene);
             self.pipeline = integrator_pipeline(
                 device,
                 &self.scene.layout,
@@ -471,9 +476,9 @@ fn frame_bind_group(
     bind_buffers(device, "frame", layout, &[params, accum, ray_counter])
 }
 
-/// Traversal stack entries for `gpu_scene`: its bound, in steps of 8.
-fn stack_size(gpu_scene: &GpuScene) -> u32 {
-    gpu_scene.traversal_stack_bound().next_multiple_of(8)
+/// Traversal stack entries for the scene in `buffers`: its bound, in steps of 8.
+fn stack_size(buffers: &SceneBuffers) -> u32 {
+    buffers.stack_bound.next_multiple_of(8)
 }
 
 /// The integrator pipeline with the given scheme and traversal stack.

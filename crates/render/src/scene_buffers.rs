@@ -1,6 +1,6 @@
 //! The scene on the device: the buffers of a [`GpuScene`] as bind group 0.
 
-use pathlight_core::GpuScene;
+use pathlight_core::{GpuScene, WideBvh};
 use wgpu::util::DeviceExt;
 
 use crate::error::RenderError;
@@ -12,6 +12,8 @@ pub struct SceneBuffers {
     pub layout: wgpu::BindGroupLayout,
     /// The bound buffers.
     pub bind_group: wgpu::BindGroup,
+    /// Most entries the traversal stack needs in this scene ([`WideBvh::stack_bound`]).
+    pub stack_bound: u32,
 }
 
 /// A read-only storage buffer entry at `binding` for compute.
@@ -29,11 +31,14 @@ pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntr
 }
 
 impl SceneBuffers {
-    /// Uploads `scene`, refusing buffers over the device's binding limit.
+    /// Uploads `scene` with its BVH in 4-wide form, refusing buffers over the device's
+    /// binding limit.
     pub fn upload(device: &wgpu::Device, scene: &GpuScene) -> Result<Self, RenderError> {
+        let bvh = WideBvh::build(scene);
+        let (nodes, objects) = (bvh.gpu_nodes(), bvh.gpu_objects(scene));
         let contents: [(&str, &[u8]); 7] = [
-            ("bvh nodes", bytemuck::cast_slice(&scene.nodes)),
-            ("objects", bytemuck::cast_slice(&scene.objects)),
+            ("bvh nodes", bytemuck::cast_slice(&nodes)),
+            ("objects", bytemuck::cast_slice(&objects)),
             ("vertices", bytemuck::cast_slice(&scene.vertices)),
             ("materials", bytemuck::cast_slice(&scene.materials)),
             ("texture table", bytemuck::cast_slice(&scene.textures)),
@@ -64,7 +69,11 @@ impl SceneBuffers {
         });
         let buffers: Vec<&wgpu::Buffer> = buffers.iter().collect();
         let bind_group = bind_buffers(device, "scene", &layout, &buffers);
-        Ok(Self { layout, bind_group })
+        Ok(Self {
+            layout,
+            bind_group,
+            stack_bound: bvh.stack_bound(scene),
+        })
     }
 }
 

@@ -5,7 +5,7 @@
 pub const SCENE: &str = include_str!("../shaders/scene.wgsl");
 /// Ray-primitive intersection.
 pub const INTERSECT: &str = include_str!("../shaders/intersect.wgsl");
-/// Two-level BVH traversal.
+/// Two-level 4-wide BVH traversal.
 pub const BVH: &str = include_str!("../shaders/bvh.wgsl");
 /// The sampler (Owen-scrambled Sobol, or hashed random numbers).
 pub const SAMPLER: &str = include_str!("../shaders/sampler.wgsl");
@@ -53,7 +53,7 @@ pub fn integrator_module() -> String {
 
 /// `module` with a traversal stack of `entries` instead of the default 64 (WGSL sizes
 /// function-scope arrays by constants only, so the size is written into the source). A
-/// stack sized to the scene (`GpuScene::traversal_stack_bound`) costs less local memory:
+/// stack sized to the scene (`WideBvh::stack_bound`) costs less local memory:
 /// 8% more frames per second on an H100 at 32 entries instead of 64.
 pub fn with_stack_size(module: &str, entries: u32) -> String {
     assert!(

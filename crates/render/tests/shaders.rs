@@ -7,7 +7,7 @@ use std::mem::{offset_of, size_of};
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use pathlight_core::gpu::{
     GpuAccumPixel, GpuBvhNode, GpuFrameParams, GpuLight, GpuMaterial, GpuObject, GpuTextureInfo,
-    GpuVertex,
+    GpuVertex, GpuWideNode,
 };
 use pathlight_render::display::GpuDisplayParams;
 use pathlight_render::shaders;
@@ -100,9 +100,9 @@ fn host_structs_match_their_wgsl_declarations() {
     assert_layout!(m, "Light", GpuLight, [object, primitive, cdf, pmf]);
     assert_layout!(
         m,
-        "BvhNode",
-        GpuBvhNode,
-        [aabb_min, pad0, aabb_max, pad1, prim_count, first_index]
+        "WideNode",
+        GpuWideNode,
+        [lo_x, lo_y, lo_z, hi_x, hi_y, hi_z, first, count]
     );
     assert_layout!(m, "Vertex", GpuVertex, [position, u, normal, v]);
     assert_layout!(

@@ -65,10 +65,7 @@ fn trace_on_gpu(gpu_scene: &GpuScene, rays: &[TraceRay], accel: Accel) -> Vec<Tr
     let source = format!(
         "const OBJECT_COUNT: u32 = {}u;\n{}{}",
         gpu_scene.object_count,
-        shaders::with_stack_size(
-            &shaders::ray_query_library(),
-            gpu_scene.traversal_stack_bound()
-        ),
+        shaders::with_stack_size(&shaders::ray_query_library(), scene.stack_bound),
         KERNEL
     );
     let pipeline = create_compute_pipeline(
