@@ -147,6 +147,26 @@ pub struct GpuVertex {
 }
 const _: () = assert!(size_of::<GpuVertex>() == 32);
 
+/// A triangle in the form the intersection test wants: its first corner and the two edges
+/// from it, in the order of the vertex buffer. WGSL: `Triangle`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuTriangle {
+    /// Corner 0.
+    pub v0: [f32; 3],
+    /// Padding.
+    pub pad0: u32,
+    /// Corner 1 minus corner 0.
+    pub e1: [f32; 3],
+    /// Padding.
+    pub pad1: u32,
+    /// Corner 2 minus corner 0.
+    pub e2: [f32; 3],
+    /// Padding.
+    pub pad2: u32,
+}
+const _: () = assert!(size_of::<GpuTriangle>() == 48);
+
 /// A material in linear RGB. WGSL: `Material`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]

@@ -166,12 +166,13 @@ pub fn intersect_cylinder(
     t_best
 }
 
-/// Moller-Trumbore; twin of WGSL `intersect_triangle`. Returns `(t, b1, b2)`.
+/// Moller-Trumbore. Returns `(t, b1, b2)`.
 pub fn intersect_triangle(v0: Vec3, v1: Vec3, v2: Vec3, ray: &Ray, t_max: f32) -> (f32, f32, f32) {
     intersect_triangle_edges(v0, v1 - v0, v2 - v0, ray, t_max)
 }
 
-/// [`intersect_triangle`] given the edges `e1 = v1 - v0` and `e2 = v2 - v0`.
+/// [`intersect_triangle`] given the edges `e1 = v1 - v0` and `e2 = v2 - v0`; twin of WGSL
+/// `intersect_triangle_edges`.
 #[inline(always)]
 pub fn intersect_triangle_edges(
     v0: Vec3,

@@ -14,7 +14,7 @@ use glam::{Vec3, Vec4};
 use obvhs::aabb::Aabb;
 
 use crate::accel::GpuScene;
-use crate::gpu::{GpuBvhNode, GpuObject, GpuWideNode, KIND_MESH};
+use crate::gpu::{GpuBvhNode, GpuObject, GpuTriangle, GpuWideNode, KIND_MESH};
 use crate::packet::Lanes;
 use crate::trace::{Hit, Ray, intersect_triangle_edges, safe_inverse};
 
@@ -144,6 +144,22 @@ impl WideBvh {
                 hi_z: n.hi[2].to_array(),
                 first: n.first,
                 count: n.count,
+            })
+            .collect()
+    }
+
+    /// The triangles as the GPU reads them. Never empty (a placeholder when there are none).
+    pub fn gpu_triangles(&self) -> Vec<GpuTriangle> {
+        if self.triangles.is_empty() {
+            return vec![GpuTriangle::zeroed()];
+        }
+        self.triangles
+            .iter()
+            .map(|[v0, e1, e2]| GpuTriangle {
+                v0: v0.to_array(),
+                e1: e1.to_array(),
+                e2: e2.to_array(),
+                ..GpuTriangle::zeroed()
             })
             .collect()
     }

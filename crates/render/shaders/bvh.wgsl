@@ -65,13 +65,8 @@ fn intersect_shape(i: u32, o: Object, ray: Ray, hit: ptr<function, Hit>) {
 // Nearest hit among triangles `first .. first + count` of mesh object `object`.
 fn intersect_triangles(object: u32, first: u32, count: u32, ray: Ray, hit: ptr<function, Hit>) {
     for (var i = first; i < first + count; i++) {
-        let r = intersect_triangle(
-            vertices[3u * i].position,
-            vertices[3u * i + 1u].position,
-            vertices[3u * i + 2u].position,
-            ray,
-            (*hit).t,
-        );
+        let tri = triangles[i];
+        let r = intersect_triangle_edges(tri.v0, tri.e1, tri.e2, ray, (*hit).t);
         if r.x < (*hit).t {
             *hit = Hit(r.x, object, i, r.y, r.z);
         }

@@ -118,10 +118,9 @@ fn intersect_cylinder(p0: vec3f, p1: vec3f, radius: f32, caps: bool, ray: Ray, t
     return t_best;
 }
 
-// Moller-Trumbore; returns (t, b1, b2) with barycentrics of vertices 1 and 2.
-fn intersect_triangle(v0: vec3f, v1: vec3f, v2: vec3f, ray: Ray, t_max: f32) -> vec3f {
-    let e1 = v1 - v0;
-    let e2 = v2 - v0;
+// Moller-Trumbore on corner v0 and edges e1 = v1 - v0, e2 = v2 - v0; returns (t, b1, b2)
+// with barycentrics of vertices 1 and 2.
+fn intersect_triangle_edges(v0: vec3f, e1: vec3f, e2: vec3f, ray: Ray, t_max: f32) -> vec3f {
     let p = cross(ray.dir, e2);
     let det = dot(e1, p);
     if abs(det) < 1e-20 {

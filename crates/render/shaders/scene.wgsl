@@ -60,6 +60,17 @@ struct Vertex {
     v: f32,
 }
 
+// A triangle for the intersection test: corner 0 and the edges to corners 1 and 2.
+// Host: `GpuTriangle`.
+struct Triangle {
+    v0: vec3f,
+    pad0: u32,
+    e1: vec3f,
+    pad1: u32,
+    e2: vec3f,
+    pad2: u32,
+}
+
 // Linear-RGB material with the seed's lobe weights. Host: `GpuMaterial`.
 struct Material {
     base_color: vec3f,
@@ -95,3 +106,5 @@ struct TextureInfo {
 @group(0) @binding(4) var<storage, read> textures: array<TextureInfo>;
 @group(0) @binding(5) var<storage, read> texels: array<u32>;
 @group(0) @binding(6) var<storage, read> lights: array<Light>;
+// Triangle i of `vertices` for the intersection test.
+@group(0) @binding(7) var<storage, read> triangles: array<Triangle>;

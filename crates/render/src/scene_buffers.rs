@@ -36,7 +36,8 @@ impl SceneBuffers {
     pub fn upload(device: &wgpu::Device, scene: &GpuScene) -> Result<Self, RenderError> {
         let bvh = WideBvh::build(scene);
         let (nodes, objects) = (bvh.gpu_nodes(), bvh.gpu_objects(scene));
-        let contents: [(&str, &[u8]); 7] = [
+        let triangles = bvh.gpu_triangles();
+        let contents: [(&str, &[u8]); 8] = [
             ("bvh nodes", bytemuck::cast_slice(&nodes)),
             ("objects", bytemuck::cast_slice(&objects)),
             ("vertices", bytemuck::cast_slice(&scene.vertices)),
@@ -44,6 +45,7 @@ impl SceneBuffers {
             ("texture table", bytemuck::cast_slice(&scene.textures)),
             ("texels", bytemuck::cast_slice(&scene.texels)),
             ("lights", bytemuck::cast_slice(&scene.lights)),
+            ("triangles", bytemuck::cast_slice(&triangles)),
         ];
         let limit = device.limits().max_storage_buffer_binding_size;
         let mut buffers = Vec::new();
@@ -65,7 +67,7 @@ impl SceneBuffers {
         }
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene layout"),
-            entries: &(0..7).map(|i| storage_entry(i, true)).collect::<Vec<_>>(),
+            entries: &(0..8).map(|i| storage_entry(i, true)).collect::<Vec<_>>(),
         });
         let buffers: Vec<&wgpu::Buffer> = buffers.iter().collect();
         let bind_group = bind_buffers(device, "scene", &layout, &buffers);
