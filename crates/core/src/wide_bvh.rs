@@ -179,43 +179,52 @@ impl WideBvh {
     }
 
     /// Most entries the traversal stack of WGSL `trace_scene` can hold at once for `scene`
-    /// (from which this tree was built). The walk pushes, at each node, the entered inner
-    /// children but the nearest and the meshes of the entered leaves, and keeps only the
-    /// pending entries of the current node's ancestors; a mesh's tree is walked above the
-    /// marker that replaces its entry. The integrator's stack is sized from it.
+    /// (from which this tree was built). At each node the walk pushes the entered children
+    /// still to visit but the nearest (inner ones in the top level, whose leaves it tests at
+    /// once, pushing their meshes; leaves too in a mesh's tree), and the stack holds only the
+    /// pending entries of the current node and its ancestors; a mesh's tree is walked above
+    /// the marker that replaces its entry. The integrator's stack is sized from it.
     pub fn stack_bound(&self, scene: &GpuScene) -> u32 {
         if !self.has_objects {
             return 1;
         }
-        let top = self.path_pushes(0, &|first, count| {
+        let meshes_in = |first: u32, count: u32| {
             (first..first + count)
                 .filter(|&i| scene.objects[i as usize].kind == KIND_MESH)
                 .count() as u32
-        });
+        };
+        let top = self.path_pushes(0, Some(&meshes_in));
         let mesh = scene.objects[..scene.object_count as usize]
             .iter()
             .zip(&self.mesh_roots)
             .filter(|(o, _)| o.kind == KIND_MESH)
-            .map(|(_, &root)| self.path_pushes(root, &|_, _| 0))
+            .map(|(_, &root)| self.path_pushes(root, None))
             .max()
             .unwrap_or(0);
         top + mesh + 1
     }
 
-    /// Most entries pushed along one path down from `node`, where a leaf of `count`
-    /// primitives from `first` pushes `leaf_pushes(first, count)`.
-    fn path_pushes(&self, node: u32, leaf_pushes: &dyn Fn(u32, u32) -> u32) -> u32 {
+    /// Most entries pushed along one path down from `node`. With `tested_leaves` a node's
+    /// leaves are tested when it is visited, a leaf of `count` primitives from `first`
+    /// pushing `tested_leaves(first, count)` entries; without, leaves are pushed like inner
+    /// children.
+    fn path_pushes(&self, node: u32, tested_leaves: Option<&dyn Fn(u32, u32) -> u32>) -> u32 {
         let n = &self.nodes[node as usize];
         let used = (0..4).filter(|&lane| n.lo[0][lane] <= n.hi[0][lane]);
         let (inner, leaves): (Vec<usize>, Vec<usize>) = used.partition(|&lane| n.count[lane] == 0);
-        let at_node = leaves
-            .iter()
-            .map(|&lane| leaf_pushes(n.first[lane], n.count[lane]))
-            .sum::<u32>()
-            + (inner.len() as u32).saturating_sub(1);
+        let at_node = match tested_leaves {
+            Some(pushes) => {
+                leaves
+                    .iter()
+                    .map(|&lane| pushes(n.first[lane], n.count[lane]))
+                    .sum::<u32>()
+                    + (inner.len() as u32).saturating_sub(1)
+            }
+            None => (inner.len() + leaves.len()).saturating_sub(1) as u32,
+        };
         let below = inner
             .iter()
-            .map(|&lane| self.path_pushes(n.first[lane], leaf_pushes))
+            .map(|&lane| self.path_pushes(n.first[lane], tested_leaves))
             .max()
             .unwrap_or(0);
         at_node + below

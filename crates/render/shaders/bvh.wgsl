@@ -1,13 +1,14 @@
 // Two-level 4-wide BVH traversal: the top level over objects, a tree per mesh, all in
 // `nodes` (`WideNode`s collapsed from obvhs BVH2s: `crates/core/src/wide_bvh.rs`). Ordered
 // depth-first with one explicit stack for both levels. At each node the four child boxes are
-// tested at once; entered leaves are intersected at once (in the top level a mesh is pushed
-// as an ENTER_MESH entry instead), the nearest entered inner child is visited next and the
-// others are pushed with their entry distances, nearest on top, to be skipped on pop if a
-// closer hit was found meanwhile. Popping an ENTER_MESH entry pushes a LEAVE_MESH marker and
-// walks the mesh's tree, whose entries all lie above the marker. Shadow rays stop at the
-// first hit. CPU twin: `Walk::tree` in `crates/core/src/wide_bvh.rs` (which visits leaves
-// nearest first; the hits are the same).
+// tested at once. In the top level the entered leaves' shapes are tested at once and a
+// leaf's mesh is pushed as an ENTER_MESH entry; popping it pushes a LEAVE_MESH marker and
+// walks the mesh's tree, whose entries all lie above the marker. The nearest entered child
+// still to visit (inner, or in a mesh's tree a leaf too) is taken next and the others are
+// pushed with their entry distances, nearest on top, to be skipped on pop if a closer hit
+// was found meanwhile. Shadow rays stop at the first hit. CPU twin: `Walk::tree` in
+// `crates/core/src/wide_bvh.rs` (which tests a node's leaves as it visits the node; the hits
+// are the same).
 //
 // `ACCEL` (a pipeline constant) selects the seed's slower schemes for benchmarks: every object
 // in turn, a mesh's triangles tested only when the ray hits the mesh's bounding box
@@ -20,9 +21,12 @@ override ACCEL: u32 = 0u;
 
 const STACK_SIZE: u32 = 64u;
 const NO_HIT: u32 = 0xffffffffu;
-// Stack entry tags: an object whose tree is still to be walked (its index in the low bits),
-// and the end of the mesh tree being walked.
+// Stack entry tags (an untagged entry is an inner node): an object whose tree is still to be
+// walked (its index in the low bits), a leaf child (node << 2 | lane in the low bits), and
+// the end of the mesh tree being walked.
 const ENTER_MESH: u32 = 0x80000000u;
+const LEAF: u32 = 0x40000000u;
+const ENTRY_TAG: u32 = 0xc0000000u;
 const LEAVE_MESH: u32 = 0xffffffffu;
 // No node left to visit.
 const NO_NODE: u32 = 0xffffffffu;
@@ -153,54 +157,50 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
     loop {
         let n = nodes[index];
         let t = enter_children(n, ray.origin, inv_dir, backwards, hit.t);
-        for (var lane = 0u; lane < 4u; lane++) {
-            let count = n.count[lane];
-            if count == 0u || t[lane] >= hit.t {
-                continue;
-            }
-            let first = n.first[lane];
-            if mesh != NO_HIT {
-                intersect_triangles(mesh, first, count, ray, &hit);
-                continue;
-            }
-            for (var i = first; i < first + count; i++) {
-                let o = objects[i];
-                if o.kind != KIND_MESH {
-                    intersect_shape(i, o, ray, &hit);
-                } else if sp < STACK_SIZE {
-                    stack_node[sp] = ENTER_MESH | i;
-                    stack_t[sp] = t[lane];
-                    sp++;
+        if mesh == NO_HIT {
+            // Top level: the entered leaves' shapes are tested now (cheaper than pushing
+            // them), a mesh is pushed as an ENTER_MESH entry.
+            for (var lane = 0u; lane < 4u; lane++) {
+                let count = n.count[lane];
+                if count == 0u || t[lane] >= hit.t {
+                    continue;
+                }
+                let first = n.first[lane];
+                for (var i = first; i < first + count; i++) {
+                    let o = objects[i];
+                    if o.kind != KIND_MESH {
+                        intersect_shape(i, o, ray, &hit);
+                    } else if sp < STACK_SIZE {
+                        stack_node[sp] = ENTER_MESH | i;
+                        stack_t[sp] = t[lane];
+                        sp++;
+                    }
                 }
             }
+            if any_hit && hit.object != NO_HIT {
+                return hit;
+            }
         }
-        if any_hit && hit.object != NO_HIT {
-            return hit;
-        }
-        // The entered inner children, nearest first (a sorting network on four keys; MISS
-        // for leaves and children not entered before the current hit).
-        let inner = n.count == vec4u(0u) & t < vec4f(hit.t);
-        var k0 = select(MISS, t.x, inner.x);
-        var k1 = select(MISS, t.y, inner.y);
-        var k2 = select(MISS, t.z, inner.z);
-        var k3 = select(MISS, t.w, inner.w);
-        var c0 = n.first.x;
-        var c1 = n.first.y;
-        var c2 = n.first.z;
-        var c3 = n.first.w;
+        // The children still to visit (in the top level its inner ones, in a mesh's tree
+        // leaves too, as LEAF entries) sorted by entry distance: a sorting network on four
+        // keys, MISS for those not entered before the current hit. The nearest is taken
+        // next, the others are pushed, farthest first.
+        let leaves = vec4u(LEAF | (index << 2u)) | vec4u(0u, 1u, 2u, 3u);
+        let entries = select(n.first, leaves, n.count != vec4u(0u));
+        let take = t < vec4f(hit.t) & (n.count == vec4u(0u) | vec4<bool>(mesh != NO_HIT));
+        var k0 = select(MISS, t.x, take.x);
+        var k1 = select(MISS, t.y, take.y);
+        var k2 = select(MISS, t.z, take.z);
+        var k3 = select(MISS, t.w, take.w);
+        var c0 = entries.x;
+        var c1 = entries.y;
+        var c2 = entries.z;
+        var c3 = entries.w;
         order_pair(&k0, &c0, &k1, &c1);
         order_pair(&k2, &c2, &k3, &c3);
         order_pair(&k0, &c0, &k2, &c2);
         order_pair(&k1, &c1, &k3, &c3);
         order_pair(&k1, &c1, &k2, &c2);
-        if k0 == MISS {
-            index = pop_entry(&stack_node, &stack_t, &sp, &mesh, hit.t);
-            if index == NO_NODE {
-                return hit;
-            }
-            continue;
-        }
-        index = c0;
         if k3 != MISS && sp < STACK_SIZE {
             stack_node[sp] = c3;
             stack_t[sp] = k3;
@@ -216,12 +216,35 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
             stack_t[sp] = k1;
             sp++;
         }
+        var next = c0;
+        if k0 == MISS {
+            next = pop_entry(&stack_node, &stack_t, &sp, &mesh, hit.t);
+        }
+        // A mesh's leaves, nearest first, until the next inner node ("while-while", Aila and
+        // Laine: a warp's lanes intersect triangles together, then walk nodes together).
+        loop {
+            if next == NO_NODE {
+                return hit;
+            }
+            if (next & ENTRY_TAG) != LEAF {
+                break;
+            }
+            let node = (next & ~LEAF) >> 2u;
+            let lane = next & 3u;
+            intersect_triangles(mesh, nodes[node].first[lane], nodes[node].count[lane], ray, &hit);
+            if any_hit && hit.object != NO_HIT {
+                return hit;
+            }
+            next = pop_entry(&stack_node, &stack_t, &sp, &mesh, hit.t);
+        }
+        index = next;
     }
     return hit;
 }
 
-// Pops the next entry whose subtree may hold a hit nearer than `t` and returns its node, or
-// NO_NODE when none is left; entering or leaving a mesh's BLAS on the way updates `mesh`.
+// Pops the next entry whose subtree may hold a hit nearer than `t` and returns it (an inner
+// node or a LEAF entry), or NO_NODE when none is left; entering or leaving a mesh's tree on
+// the way updates `mesh`.
 fn pop_entry(
     stack_node: ptr<function, array<u32, STACK_SIZE>>,
     stack_t: ptr<function, array<f32, STACK_SIZE>>,
