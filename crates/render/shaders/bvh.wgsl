@@ -148,8 +148,8 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
         return hit;
     }
     let backwards = inv_dir < vec3f(0.0);
-    var stack_node: array<u32, STACK_SIZE>;
-    var stack_t: array<f32, STACK_SIZE>;
+    // Entries (node or tagged entry, bits of the entry distance), one 8-byte store each.
+    var stack: array<vec2u, STACK_SIZE>;
     var sp = 0u;
     var index = 0u;
     // The mesh whose tree is being walked, or NO_HIT in the top level.
@@ -171,8 +171,7 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
                     if o.kind != KIND_MESH {
                         intersect_shape(i, o, ray, &hit);
                     } else if sp < STACK_SIZE {
-                        stack_node[sp] = ENTER_MESH | i;
-                        stack_t[sp] = t[lane];
+                        stack[sp] = vec2u(ENTER_MESH | i, bitcast<u32>(t[lane]));
                         sp++;
                     }
                 }
@@ -202,23 +201,20 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
         order_pair(&k1, &c1, &k3, &c3);
         order_pair(&k1, &c1, &k2, &c2);
         if k3 != MISS && sp < STACK_SIZE {
-            stack_node[sp] = c3;
-            stack_t[sp] = k3;
+            stack[sp] = vec2u(c3, bitcast<u32>(k3));
             sp++;
         }
         if k2 != MISS && sp < STACK_SIZE {
-            stack_node[sp] = c2;
-            stack_t[sp] = k2;
+            stack[sp] = vec2u(c2, bitcast<u32>(k2));
             sp++;
         }
         if k1 != MISS && sp < STACK_SIZE {
-            stack_node[sp] = c1;
-            stack_t[sp] = k1;
+            stack[sp] = vec2u(c1, bitcast<u32>(k1));
             sp++;
         }
         var next = c0;
         if k0 == MISS {
-            next = pop_entry(&stack_node, &stack_t, &sp, &mesh, hit.t);
+            next = pop_entry(&stack, &sp, &mesh, hit.t);
         }
         // A mesh's leaves, nearest first, until the next inner node ("while-while", Aila and
         // Laine: a warp's lanes intersect triangles together, then walk nodes together).
@@ -235,7 +231,7 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
             if any_hit && hit.object != NO_HIT {
                 return hit;
             }
-            next = pop_entry(&stack_node, &stack_t, &sp, &mesh, hit.t);
+            next = pop_entry(&stack, &sp, &mesh, hit.t);
         }
         index = next;
     }
@@ -246,26 +242,26 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
 // node or a LEAF entry), or NO_NODE when none is left; entering or leaving a mesh's tree on
 // the way updates `mesh`.
 fn pop_entry(
-    stack_node: ptr<function, array<u32, STACK_SIZE>>,
-    stack_t: ptr<function, array<f32, STACK_SIZE>>,
+    stack: ptr<function, array<vec2u, STACK_SIZE>>,
     sp: ptr<function, u32>,
     mesh: ptr<function, u32>,
     t: f32,
 ) -> u32 {
     while *sp > 0u {
         *sp -= 1u;
-        let entry = (*stack_node)[*sp];
+        let top = (*stack)[*sp];
+        let entry = top.x;
         if entry == LEAVE_MESH {
             *mesh = NO_HIT;
             continue;
         }
-        if (*stack_t)[*sp] >= t {
+        if bitcast<f32>(top.y) >= t {
             continue;
         }
         if (entry & ENTER_MESH) != 0u {
             *mesh = entry & ~ENTER_MESH;
             // The slot just freed holds the marker below the BLAS entries.
-            (*stack_node)[*sp] = LEAVE_MESH;
+            (*stack)[*sp].x = LEAVE_MESH;
             *sp += 1u;
             return objects[*mesh].blas_root;
         }
