@@ -22,7 +22,8 @@ override ACCEL: u32 = 0u;
 const STACK_SIZE: u32 = 64u;
 const NO_HIT: u32 = 0xffffffffu;
 // Stack entry tags (an untagged entry is an inner node): an object whose tree is still to be
-// walked (its index in the low bits), a leaf child (node << 2 | lane in the low bits), and
+// walked (its index in the low bits), a leaf child (node << 2 | lane in the low bits: the
+// host refuses trees of 2^28 nodes or more), and
 // the end of the mesh tree being walked.
 const ENTER_MESH: u32 = 0x80000000u;
 const LEAF: u32 = 0x40000000u;

@@ -5,6 +5,10 @@ use wgpu::util::DeviceExt;
 
 use crate::error::RenderError;
 
+/// Nodes the traversal can address: its leaf entries hold `node << 2 | lane` in 30 bits
+/// (`LEAF` in `shaders/bvh.wgsl`).
+const MAX_NODES: usize = 1 << 28;
+
 /// Bind group 0 of every ray-casting pass (see `shaders/scene.wgsl`).
 #[derive(Debug)]
 pub struct SceneBuffers {
@@ -36,6 +40,12 @@ impl SceneBuffers {
     pub fn upload(device: &wgpu::Device, scene: &GpuScene) -> Result<Self, RenderError> {
         let bvh = WideBvh::build(scene);
         let (nodes, objects) = (bvh.gpu_nodes(), bvh.gpu_objects(scene));
+        if nodes.len() >= MAX_NODES {
+            return Err(RenderError::Limits(format!(
+                "the scene's BVH has {} nodes; the traversal addresses at most {MAX_NODES}",
+                nodes.len()
+            )));
+        }
         let triangles = bvh.gpu_triangles();
         let contents: [(&str, &[u8]); 8] = [
             ("bvh nodes", bytemuck::cast_slice(&nodes)),

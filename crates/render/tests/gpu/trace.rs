@@ -53,7 +53,14 @@ struct TraceHit {
     blocked: u32,
 }
 
-fn trace_on_gpu(gpu_scene: &GpuScene, rays: &[TraceRay], accel: Accel) -> Vec<TraceHit> {
+/// `rays` traced on the GPU with the scheme `accel` and a traversal stack of the scene's bound
+/// divided by `stack_divisor` (1: as the integrator sizes it).
+fn trace_on_gpu(
+    gpu_scene: &GpuScene,
+    rays: &[TraceRay],
+    accel: Accel,
+    stack_divisor: u32,
+) -> Vec<TraceHit> {
     let ctx = context();
     let device = &ctx.device;
     let scene = SceneBuffers::upload(device, gpu_scene).unwrap();
@@ -61,12 +68,13 @@ fn trace_on_gpu(gpu_scene: &GpuScene, rays: &[TraceRay], accel: Accel) -> Vec<Tr
         label: Some("trace test"),
         entries: &[storage_entry(0, true), storage_entry(1, false)],
     });
-    // The stack sized by the scene's bound, as the integrator sizes it (random rays through
-    // this scene use far fewer entries: a third of the bound still passes).
     let source = format!(
         "const OBJECT_COUNT: u32 = {}u;\n{}{}",
         gpu_scene.object_count,
-        shaders::with_stack_size(&shaders::ray_query_library(), scene.stack_bound),
+        shaders::with_stack_size(
+            &shaders::ray_query_library(),
+            scene.stack_bound / stack_divisor
+        ),
         KERNEL
     );
     let pipeline = create_compute_pipeline(
@@ -166,7 +174,7 @@ fn wgsl_traversal_matches_cpu_twin() {
         check_hits(
             &gpu_scene,
             &rays,
-            &trace_on_gpu(&gpu_scene, &rays, accel),
+            &trace_on_gpu(&gpu_scene, &rays, accel, 1),
             accel,
         );
     }
@@ -214,5 +222,75 @@ fn check_hits(gpu_scene: &GpuScene, rays: &[TraceRay], hits: &[TraceHit], accel:
     assert!(
         mismatches <= 5,
         "{accel:?}: {mismatches} rays hit a different primitive on the GPU"
+    );
+}
+
+/// Rays that fill the traversal stack: a row of 200 spheres along -z whose boxes every ray
+/// enters near a corner without touching a sphere, and small targets in the first gaps of
+/// the row, each on the line of one ray. The walk pushes the farther children of every node
+/// on its way to the first sphere and finds its target only in one of those entries, so a
+/// stack smaller than the scene's bound loses targets; the bound loses none.
+#[test]
+fn traversal_stack_bound_holds_the_deepest_walk() {
+    const SPHERES: usize = 200;
+    // Ray lines through the corner region of the spheres' boxes (radius 0.1): outside every
+    // sphere (0.0778 * sqrt(2) > 0.1), at least 0.01 apart.
+    let lines: Vec<(f32, f32)> = [0.078f32, 0.09]
+        .iter()
+        .flat_map(|&x| [0.078f32, 0.09].map(|y| (x, y)))
+        .flat_map(|(x, y)| [(x, y), (-x, y), (x, -y), (-x, -y)])
+        .collect();
+    let mut text = String::from(
+        "[camera]\nposition = [0, 0, 1]\nlook_at = [0, 0, 0]\nfov_y = 40\n\
+         resolution = [8, 8]\n[materials.white]\ncolor = [0.5, 0.5, 0.5]\n",
+    );
+    let sphere = |text: &mut String, center: Vec3, radius: f32| {
+        text.push_str(&format!(
+            "[[sphere]]\nmaterial = \"white\"\ncenter = [{}, {}, {}]\nradius = {radius}\n",
+            center.x, center.y, center.z
+        ));
+    };
+    for i in 0..SPHERES {
+        sphere(&mut text, Vec3::new(0.0, 0.0, -0.3 * i as f32), 0.1);
+    }
+    // Target j (scene object SPHERES + j) lies on line j, in the gap after sphere j.
+    for (j, &(x, y)) in lines.iter().enumerate() {
+        sphere(&mut text, Vec3::new(x, y, -0.3 * j as f32 - 0.15), 0.004);
+    }
+    let scene = pathlight_core::load_scene(&pathlight_core::SceneSource {
+        name: "sphere row".into(),
+        text: &text,
+        base_dir: Default::default(),
+        embedded: &[],
+    })
+    .unwrap();
+    let gpu_scene = GpuScene::build(&scene);
+    let rays: Vec<TraceRay> = lines
+        .iter()
+        .map(|&(x, y)| TraceRay {
+            origin: [x, y, 1.0],
+            t_max: 1e30,
+            dir: [0.0, 0.0, -1.0],
+            pad: 0.0,
+        })
+        .collect();
+    let targets_found = |stack_divisor: u32| {
+        let hits = trace_on_gpu(&gpu_scene, &rays, Accel::Bvh, stack_divisor);
+        hits.iter()
+            .enumerate()
+            .filter(|(j, hit)| {
+                hit.object != u32::MAX
+                    && gpu_scene.objects[hit.object as usize].id as usize == SPHERES + j
+            })
+            .count()
+    };
+    assert_eq!(
+        targets_found(1),
+        lines.len(),
+        "a target was lost with the stack the integrator gets"
+    );
+    assert!(
+        targets_found(3) < lines.len(),
+        "a third of the bound still found every target: the rays do not fill the stack"
     );
 }
