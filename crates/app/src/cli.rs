@@ -101,7 +101,7 @@ pub struct RenderArgs {
 /// How the nearest hit is found (`pathlight bench --accel`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum AccelArg {
-    /// The two-level BVH (what `render` uses).
+    /// The BVH over every shape and triangle (what `render` uses).
     Bvh,
     /// Every object in turn; a mesh's triangles only inside its bounding box (the seed's
     /// bounding cylinder).

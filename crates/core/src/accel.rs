@@ -1,12 +1,12 @@
-//! Acceleration structure: a BLAS per mesh and a top level over all objects, flattened into
-//! the buffers the GPU reads; the binary trees are collapsed into 4-wide ones
-//! ([`crate::WideBvh`]) for both backends and walked as they are by the viewer's picking
-//! ([`crate::trace`]).
+//! Acceleration structure: one BVH over every primitive of the scene (each quad, sphere and
+//! cylinder, and each triangle of every mesh), flattened into the buffers the GPU reads; the
+//! binary tree is collapsed into a 4-wide one ([`crate::WideBvh`]) for both backends and
+//! walked as it is by the viewer's picking ([`crate::trace`]).
 //!
-//! Both levels are obvhs BVH2s (PLOC build, reinsertion, SAH-driven leaf collapse), laid out
-//! in one node array: the top level first (root at 0), then each BLAS with its indices
-//! rebased. Leaves index primitives directly: objects and triangles are stored in the order
-//! of obvhs' `primitive_indices`.
+//! The tree is an obvhs BVH2 (PLOC build, reinsertion, SAH-driven leaf collapse). Its leaves
+//! index [`GpuScene::primitives`], stored in the order of obvhs' `primitive_indices`. Meshes
+//! are not instanced (their triangles are in world space), so one tree over everything is
+//! as tight as two levels and sends no ray from a top-level walk into a mesh's.
 
 use std::time::Duration;
 
@@ -14,25 +14,28 @@ use bytemuck::Zeroable;
 use glam::{Vec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
-use obvhs::bvh2::Bvh2;
-use obvhs::bvh2::builder::{build_bvh2, build_bvh2_from_tris};
-use obvhs::triangle::Triangle;
+use obvhs::bvh2::builder::build_bvh2;
 
 use crate::gpu::{
-    FLAG_CAPS, FLAG_FLAT, GpuBvhNode, GpuLight, GpuMaterial, GpuObject, GpuTextureInfo, GpuVertex,
-    KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE, NO_LIGHT,
+    FLAG_CAPS, FLAG_FLAT, GpuBvhNode, GpuLight, GpuMaterial, GpuObject, GpuPrimitive,
+    GpuTextureInfo, GpuVertex, KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE, NO_LIGHT,
+    NO_TRIANGLE,
 };
 use crate::scene::{Object, Scene, Shape, TriangleMesh};
 
 /// The scene in the form the GPU reads it.
 #[derive(Debug, Clone, Default)]
 pub struct GpuScene {
-    /// The binary trees: top level at 0, then every BLAS. Never empty (a placeholder when
-    /// there are no objects). The GPU reads their 4-wide form, [`crate::WideBvh`].
+    /// The binary tree over [`Self::primitives`], root at 0. Never empty (a placeholder that
+    /// nothing walks when there are no primitives). The GPU reads its 4-wide form,
+    /// [`crate::WideBvh`].
     pub nodes: Vec<GpuBvhNode>,
-    /// Objects in top-level leaf order.
+    /// Every shape and triangle, in leaf order.
+    pub primitives: Vec<GpuPrimitive>,
+    /// Objects in the scene's order.
     pub objects: Vec<GpuObject>,
-    /// Triangle corners, three per triangle, in BLAS leaf order. Never empty.
+    /// Triangle corners, three per triangle, each mesh's triangles together (in leaf
+    /// order). Never empty.
     pub vertices: Vec<GpuVertex>,
     /// Materials.
     pub materials: Vec<GpuMaterial>,
@@ -48,49 +51,21 @@ pub struct GpuScene {
     pub light_count: u32,
 }
 
-fn node_from(node: &obvhs::bvh2::node::Bvh2Node, index_base: u32) -> GpuBvhNode {
+fn node_from(node: &obvhs::bvh2::node::Bvh2Node) -> GpuBvhNode {
     GpuBvhNode {
         aabb_min: node.aabb.min.to_array(),
         pad0: 0,
         aabb_max: node.aabb.max.to_array(),
         pad1: 0,
         prim_count: node.prim_count,
-        first_index: node.first_index + index_base,
+        first_index: node.first_index,
         pad2: [0; 2],
     }
-}
-
-/// Appends `bvh` to `nodes`: inner nodes rebased by the node offset, leaves by `prim_base`.
-fn append_bvh(nodes: &mut Vec<GpuBvhNode>, bvh: &Bvh2, prim_base: u32) -> u32 {
-    let node_base = nodes.len() as u32;
-    nodes.extend(bvh.nodes.iter().map(|n| {
-        let base = if n.prim_count == 0 {
-            node_base
-        } else {
-            prim_base
-        };
-        node_from(n, base)
-    }));
-    node_base
 }
 
 /// Build settings: obvhs' medium preset (SAH-quality PLOC with reinsertion).
 fn build_params() -> BvhBuildParams {
     BvhBuildParams::medium_build()
-}
-
-/// Builds the BVH of one mesh's triangles.
-pub fn build_mesh_bvh(mesh: &TriangleMesh) -> Bvh2 {
-    let triangles: Vec<Triangle> = mesh
-        .indices
-        .iter()
-        .map(|t| {
-            let [v0, v1, v2] = t.map(|i| Vec3A::from(mesh.positions[i as usize]));
-            Triangle { v0, v1, v2 }
-        })
-        .collect();
-    let mut build_time = Duration::ZERO;
-    build_bvh2_from_tris(&triangles, build_params(), &mut build_time)
 }
 
 /// World-space bounds of an analytic shape, grown slightly so flat shapes have volume.
@@ -154,20 +129,12 @@ fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
     }
 }
 
-/// Geometry of an object without its mesh part.
-fn gpu_object(object: &Object, id: u32) -> GpuObject {
+/// An object's geometry; a mesh's triangle range is set by [`GpuScene::build`].
+fn gpu_object(object: &Object, bounds: &Aabb) -> GpuObject {
     let mut o = GpuObject {
-        a: [0.0; 4],
-        b: [0.0; 4],
-        c: [0.0; 4],
-        kind: 0,
         material: object.material,
-        blas_root: 0,
-        id,
-        flags: 0,
         light: NO_LIGHT,
-        first_triangle: 0,
-        triangle_count: 0,
+        ..GpuObject::zeroed()
     };
     match object.shape {
         Shape::Quad {
@@ -204,6 +171,8 @@ fn gpu_object(object: &Object, id: u32) -> GpuObject {
         }
         Shape::Mesh(ref mesh) => {
             o.kind = KIND_MESH;
+            o.a = Vec3::from(bounds.min).extend(0.0).to_array();
+            o.b = Vec3::from(bounds.max).extend(0.0).to_array();
             if mesh.flat {
                 o.flags |= FLAG_FLAT;
             }
@@ -212,8 +181,25 @@ fn gpu_object(object: &Object, id: u32) -> GpuObject {
     o
 }
 
+/// Box around triangle `t` of `mesh`.
+fn triangle_bounds(mesh: &TriangleMesh, t: usize) -> Aabb {
+    let [v0, v1, v2] = mesh.indices[t].map(|i| Vec3A::from(mesh.positions[i as usize]));
+    Aabb {
+        min: v0.min(v1).min(v2),
+        max: v0.max(v1).max(v2),
+    }
+}
+
+/// A primitive before the build: object `object`, and `triangle` of its mesh or
+/// [`NO_TRIANGLE`] for a whole shape.
+#[derive(Clone, Copy)]
+struct PrimitiveRef {
+    object: u32,
+    triangle: u32,
+}
+
 impl GpuScene {
-    /// Builds both BVH levels and flattens the scene.
+    /// Builds the BVH over every primitive and flattens the scene.
     pub fn build(scene: &Scene) -> Self {
         let mut out = GpuScene {
             materials: scene.materials.iter().map(gpu_material).collect(),
@@ -229,27 +215,40 @@ impl GpuScene {
             });
             out.texels.extend_from_slice(&texture.texels);
         }
-        let bounds: Vec<Aabb> = scene
-            .objects
-            .iter()
-            .map(|o| shape_bounds(&o.shape))
-            .collect();
-        if bounds.is_empty() {
+        let mut refs = Vec::new();
+        let mut bounds = Vec::new();
+        for (i, object) in scene.objects.iter().enumerate() {
+            let object_bounds = shape_bounds(&object.shape);
+            out.objects.push(gpu_object(object, &object_bounds));
+            let i = i as u32;
+            if let Shape::Mesh(mesh) = &object.shape {
+                for t in 0..mesh.indices.len() {
+                    refs.push(PrimitiveRef {
+                        object: i,
+                        triangle: t as u32,
+                    });
+                    bounds.push(triangle_bounds(mesh, t));
+                }
+            } else {
+                refs.push(PrimitiveRef {
+                    object: i,
+                    triangle: NO_TRIANGLE,
+                });
+                bounds.push(object_bounds);
+            }
+        }
+        if refs.is_empty() {
             out.nodes.push(GpuBvhNode::zeroed());
         } else {
             let mut build_time = Duration::ZERO;
-            let top = build_bvh2(&bounds, build_params(), &mut build_time);
-            append_bvh(&mut out.nodes, &top, 0);
-            for &id in &top.primitive_indices {
-                let object = &scene.objects[id as usize];
-                let mut gpu = gpu_object(object, id);
-                if let Shape::Mesh(mesh) = &object.shape {
-                    gpu.first_triangle = (out.vertices.len() / 3) as u32;
-                    gpu.blas_root = out.append_mesh(mesh);
-                    gpu.triangle_count = (out.vertices.len() / 3) as u32 - gpu.first_triangle;
-                }
-                out.objects.push(gpu);
-            }
+            let tree = build_bvh2(&bounds, build_params(), &mut build_time);
+            out.nodes = tree.nodes.iter().map(node_from).collect();
+            let leaf_order: Vec<PrimitiveRef> = tree
+                .primitive_indices
+                .iter()
+                .map(|&p| refs[p as usize])
+                .collect();
+            out.lay_out_meshes(scene, &leaf_order);
         }
         out.build_lights();
         if out.objects.is_empty() {
@@ -271,6 +270,59 @@ impl GpuScene {
             out.lights.push(GpuLight::zeroed());
         }
         out
+    }
+
+    /// Fills the vertex buffer, each mesh's triangles together in the order the leaves hold
+    /// them (so that a leaf's triangles lie side by side for shading too), and the
+    /// primitives in leaf order.
+    fn lay_out_meshes(&mut self, scene: &Scene, leaf_order: &[PrimitiveRef]) {
+        let mut by_mesh: Vec<Vec<u32>> = vec![Vec::new(); scene.objects.len()];
+        for p in leaf_order.iter().filter(|p| p.triangle != NO_TRIANGLE) {
+            by_mesh[p.object as usize].push(p.triangle);
+        }
+        // Per object, where each of its triangles lands in the vertex buffer.
+        let mut slot: Vec<Vec<u32>> = vec![Vec::new(); scene.objects.len()];
+        for (i, object) in scene.objects.iter().enumerate() {
+            let Shape::Mesh(mesh) = &object.shape else {
+                continue;
+            };
+            let first = (self.vertices.len() / 3) as u32;
+            self.objects[i].first_triangle = first;
+            self.objects[i].triangle_count = by_mesh[i].len() as u32;
+            slot[i] = vec![0; mesh.indices.len()];
+            for (k, &t) in by_mesh[i].iter().enumerate() {
+                slot[i][t as usize] = first + k as u32;
+                for v in mesh.indices[t as usize] {
+                    let v = v as usize;
+                    let uv = mesh.uvs.get(v).copied().unwrap_or_default();
+                    self.vertices.push(GpuVertex {
+                        position: mesh.positions[v].to_array(),
+                        u: uv.x,
+                        normal: mesh.normals.get(v).copied().unwrap_or_default().to_array(),
+                        v: uv.y,
+                    });
+                }
+            }
+        }
+        self.primitives = leaf_order
+            .iter()
+            .map(|p| {
+                let mut primitive = GpuPrimitive {
+                    object: p.object,
+                    triangle: NO_TRIANGLE,
+                    ..GpuPrimitive::zeroed()
+                };
+                if p.triangle != NO_TRIANGLE {
+                    let triangle = slot[p.object as usize][p.triangle as usize];
+                    let [v0, v1, v2] = self.triangle(triangle);
+                    primitive.v0 = v0.to_array();
+                    primitive.e1 = (v1 - v0).to_array();
+                    primitive.e2 = (v2 - v0).to_array();
+                    primitive.triangle = triangle;
+                }
+                primitive
+            })
+            .collect();
     }
 
     /// Surface area of light-table entry `(object, primitive)`: the whole shape, or
@@ -347,25 +399,5 @@ impl GpuScene {
         if self.lights.is_empty() {
             self.lights.push(GpuLight::zeroed());
         }
-    }
-
-    /// Appends a mesh's BLAS and triangles; returns the BLAS root's node index.
-    fn append_mesh(&mut self, mesh: &TriangleMesh) -> u32 {
-        let bvh = build_mesh_bvh(mesh);
-        let triangle_base = (self.vertices.len() / 3) as u32;
-        let root = append_bvh(&mut self.nodes, &bvh, triangle_base);
-        for &t in &bvh.primitive_indices {
-            for i in mesh.indices[t as usize] {
-                let i = i as usize;
-                let uv = mesh.uvs.get(i).copied().unwrap_or_default();
-                self.vertices.push(GpuVertex {
-                    position: mesh.positions[i].to_array(),
-                    u: uv.x,
-                    normal: mesh.normals.get(i).copied().unwrap_or_default().to_array(),
-                    v: uv.y,
-                });
-            }
-        }
-        root
     }
 }

@@ -28,11 +28,12 @@ pub const FLAG_FLAT: u32 = 1;
 /// [`GpuObject::flags`] bit: a cylinder closed by two disks.
 pub const FLAG_CAPS: u32 = 2;
 
-/// One object, a leaf of the top-level BVH. WGSL: `Object`.
+/// One object of the scene, in the scene's order. WGSL: `Object`.
 ///
 /// Geometry by kind: quad `a` = origin, `b` = edge_u, `c` = edge_v; sphere `a.xyz` = centre,
 /// `a.w` = radius, `b.x` = texture rotation (radians); cylinder `a.xyz` = p0, `a.w` = radius,
-/// `b.xyz` = p1; mesh: the triangles under the BLAS rooted at `blas_root`.
+/// `b.xyz` = p1; mesh: its triangles `first_triangle ..` in the vertex buffer, and the box
+/// around them from `a.xyz` to `b.xyz` (for the seed's bounding-volume scheme).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuObject {
@@ -46,11 +47,6 @@ pub struct GpuObject {
     pub kind: u32,
     /// Index into the material buffer.
     pub material: u32,
-    /// Mesh only: index of the BLAS root in the node buffer ([`crate::GpuScene::nodes`]; on
-    /// the device, in the 4-wide nodes: [`crate::WideBvh::gpu_objects`]).
-    pub blas_root: u32,
-    /// Index of the object in [`crate::Scene::objects`] (the top level reorders objects).
-    pub id: u32,
     /// `FLAG_*` bits.
     pub flags: u32,
     /// Its first entry in the light table, or [`NO_LIGHT`]. A mesh has one entry per
@@ -60,6 +56,8 @@ pub struct GpuObject {
     pub first_triangle: u32,
     /// Mesh only: number of its triangles (`first_triangle ..` in the vertex buffer).
     pub triangle_count: u32,
+    /// Padding to 16 bytes.
+    pub pad: [u32; 2],
 }
 const _: () = assert!(size_of::<GpuObject>() == 80);
 
@@ -68,7 +66,7 @@ const _: () = assert!(size_of::<GpuObject>() == 80);
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuLight {
-    /// Index into the object buffer (top-level order).
+    /// Index into the object buffer.
     pub object: u32,
     /// Triangle index for a mesh light, 0 otherwise.
     pub primitive: u32,
@@ -80,13 +78,13 @@ pub struct GpuLight {
 }
 const _: () = assert!(size_of::<GpuLight>() == 16);
 
-/// One BVH2 node in the layout of `obvhs::bvh2::node::Bvh2Node`: the binary trees of
-/// [`crate::GpuScene`], which [`crate::WideBvh`] collapses into the 4-wide ones both backends
+/// One BVH2 node in the layout of `obvhs::bvh2::node::Bvh2Node`: the binary tree of
+/// [`crate::GpuScene`], which [`crate::WideBvh`] collapses into the 4-wide one both backends
 /// walk (the GPU reads [`GpuWideNode`]s, not these).
 ///
 /// If `prim_count` is 0 this is an inner node whose children are `first_index` and
 /// `first_index + 1`; otherwise it is a leaf holding primitives
-/// `first_index .. first_index + prim_count` (objects in the top level, triangles in a BLAS).
+/// `first_index .. first_index + prim_count` ([`crate::GpuScene::primitives`]).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuBvhNode {
@@ -127,10 +125,15 @@ pub struct GpuWideNode {
     pub hi_z: [f32; 4],
     /// Per child: an inner node's index, or a leaf's first primitive.
     pub first: [u32; 4],
-    /// Per child: a leaf's number of primitives; 0 for an inner node or an unused child.
+    /// Per child: a leaf's number of primitives, with [`SHAPE_LEAF`] set when any of them
+    /// is not a triangle; 0 for an inner node or an unused child.
     pub count: [u32; 4],
 }
 const _: () = assert!(size_of::<GpuWideNode>() == 128);
+
+/// [`GpuWideNode::count`] bit: the leaf holds a shape (not only triangles), and the GPU tests
+/// it as soon as it enters the box instead of pushing it.
+pub const SHAPE_LEAF: u32 = 1 << 31;
 
 /// One triangle corner. WGSL: `Vertex`; a triangle is three consecutive vertices.
 #[repr(C)]
@@ -147,25 +150,29 @@ pub struct GpuVertex {
 }
 const _: () = assert!(size_of::<GpuVertex>() == 32);
 
-/// A triangle in the form the intersection test wants: its first corner and the two edges
-/// from it, in the order of the vertex buffer. WGSL: `Triangle`.
+/// [`GpuPrimitive::triangle`] of a quad, sphere or cylinder.
+pub const NO_TRIANGLE: u32 = u32::MAX;
+
+/// One primitive of the BVH, in leaf order: a triangle in the form the intersection test
+/// wants (its first corner and the two edges from it) or a whole analytic shape. WGSL:
+/// `Primitive`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct GpuTriangle {
-    /// Corner 0.
+pub struct GpuPrimitive {
+    /// Triangle: corner 0.
     pub v0: [f32; 3],
-    /// Padding.
-    pub pad0: u32,
-    /// Corner 1 minus corner 0.
+    /// The object it belongs to (index into the object buffer).
+    pub object: u32,
+    /// Triangle: corner 1 minus corner 0.
     pub e1: [f32; 3],
-    /// Padding.
-    pub pad1: u32,
-    /// Corner 2 minus corner 0.
+    /// The triangle's index in the vertex buffer, or [`NO_TRIANGLE`] for a shape.
+    pub triangle: u32,
+    /// Triangle: corner 2 minus corner 0.
     pub e2: [f32; 3],
     /// Padding.
-    pub pad2: u32,
+    pub pad: u32,
 }
-const _: () = assert!(size_of::<GpuTriangle>() == 48);
+const _: () = assert!(size_of::<GpuPrimitive>() == 48);
 
 /// A material in linear RGB. WGSL: `Material`.
 #[repr(C)]
@@ -245,7 +252,7 @@ pub struct GpuFrameParams {
     pub rr_depth: u32,
     /// Seed of the random sequence.
     pub seed: u32,
-    /// Number of objects (0: the node buffer holds a placeholder).
+    /// Number of objects.
     pub object_count: u32,
     /// First row this dispatch covers (long renders are split into row bands).
     pub row_offset: u32,

@@ -15,7 +15,7 @@ use std::ops::Range;
 use glam::Vec3;
 
 use crate::GpuScene;
-use crate::gpu::{FLAG_CAPS, KIND_MESH, KIND_QUAD, KIND_SPHERE};
+use crate::gpu::{FLAG_CAPS, KIND_QUAD, KIND_SPHERE, NO_TRIANGLE};
 use crate::trace::{
     Hit, Ray, intersect_cylinder, intersect_quad, intersect_sphere, intersect_triangle_edges,
     safe_inverse,
@@ -250,7 +250,7 @@ impl Tracer<'_> {
             b2: [0.0; PACKET],
             searching: active,
         };
-        if self.bvh.has_objects && active != 0 {
+        if !self.bvh.nodes.is_empty() && active != 0 {
             let walk = PacketWalk {
                 bvh: self.bvh,
                 scene: self.scene,
@@ -263,7 +263,7 @@ impl Tracer<'_> {
                 packet: &mut self.packet_stack,
                 single: &mut self.stack,
             };
-            walk.tree(&mut stacks, 0, active, &mut hits, &TopLevel);
+            walk.tree(&mut stacks, 0, active, &mut hits);
         }
         hits
     }
@@ -276,66 +276,6 @@ struct Stacks<'a> {
     single: &'a mut Vec<Entry>,
 }
 
-/// The tree a packet walks, which says what its leaves hold.
-trait Level {
-    /// Tests the leaf holding `range` with the rays `lanes`.
-    fn leaf(
-        &self,
-        walk: &PacketWalk,
-        stacks: &mut Stacks,
-        range: Range<u32>,
-        lanes: Lanes,
-        hits: &mut PacketHits,
-    );
-
-    /// The mesh object whose tree this is; `None` for the top level.
-    fn mesh(&self) -> Option<u32>;
-}
-
-/// The top level: leaves hold objects.
-struct TopLevel;
-
-/// The tree of mesh object `.0`: leaves hold triangles.
-struct Mesh(u32);
-
-impl Level for TopLevel {
-    #[inline(always)]
-    fn leaf(
-        &self,
-        walk: &PacketWalk,
-        stacks: &mut Stacks,
-        range: Range<u32>,
-        lanes: Lanes,
-        hits: &mut PacketHits,
-    ) {
-        walk.objects(stacks, range, lanes, hits);
-    }
-
-    #[inline(always)]
-    fn mesh(&self) -> Option<u32> {
-        None
-    }
-}
-
-impl Level for Mesh {
-    #[inline(always)]
-    fn leaf(
-        &self,
-        walk: &PacketWalk,
-        _: &mut Stacks,
-        range: Range<u32>,
-        lanes: Lanes,
-        hits: &mut PacketHits,
-    ) {
-        walk.triangles(self.0, range, lanes, hits);
-    }
-
-    #[inline(always)]
-    fn mesh(&self) -> Option<u32> {
-        Some(self.0)
-    }
-}
-
 /// One packet query in progress.
 struct PacketWalk<'a> {
     bvh: &'a WideBvh,
@@ -346,17 +286,10 @@ struct PacketWalk<'a> {
 
 impl PacketWalk<'_> {
     /// Walks the tree at `root` with the rays `lanes`, nearest boxes first (as seen by the
-    /// rays entering them). Leaves go to `level` as their node is visited; where fewer than
+    /// rays entering them). Leaves are tested as their node is visited; where fewer than
     /// [`MIN_SHARED_RAYS`] rays enter a node, each goes on alone from there.
     #[inline(always)]
-    fn tree(
-        &self,
-        stacks: &mut Stacks,
-        root: u32,
-        lanes: Lanes,
-        hits: &mut PacketHits,
-        level: &impl Level,
-    ) {
+    fn tree(&self, stacks: &mut Stacks, root: u32, lanes: Lanes, hits: &mut PacketHits) {
         let base = stacks.packet.len();
         stacks.packet.push((root, lanes));
         while stacks.packet.len() > base {
@@ -368,7 +301,7 @@ impl PacketWalk<'_> {
                 while lanes != 0 {
                     let l = lanes.trailing_zeros() as usize;
                     lanes &= lanes - 1;
-                    self.alone(stacks, l, node, hits, level.mesh());
+                    self.alone(stacks, l, node, hits);
                 }
                 continue;
             }
@@ -396,8 +329,7 @@ impl PacketWalk<'_> {
                 let child_lanes = child_lanes & hits.searching;
                 if n.count[child] > 0 && child_lanes != 0 {
                     let first = n.first[child];
-                    let range = first..first + n.count[child];
-                    level.leaf(self, stacks, range, child_lanes, hits);
+                    self.primitives(first..first + n.count[child], child_lanes, hits);
                 }
             }
             for &(_, child_lanes, child) in order[..entered].iter().rev() {
@@ -444,44 +376,32 @@ impl PacketWalk<'_> {
         (near[0], entered)
     }
 
-    /// Tests the top-level objects `range` with the rays `lanes`, walking the tree of each
-    /// mesh among them.
+    /// Tests the primitives `range` with the rays `lanes`.
     #[inline(always)]
-    fn objects(&self, stacks: &mut Stacks, range: Range<u32>, lanes: Lanes, hits: &mut PacketHits) {
+    fn primitives(&self, range: Range<u32>, lanes: Lanes, hits: &mut PacketHits) {
+        let rays = self.rays;
         for i in range {
             let lanes = lanes & hits.searching;
-            if lanes == 0 {
-                return;
+            let p = &self.scene.primitives[i as usize];
+            if p.triangle != NO_TRIANGLE {
+                let triangle = Triangle([p.v0, p.e1, p.e2].map(Vec3::from));
+                hits.test(rays, lanes, p.object, p.triangle, &triangle);
+                continue;
             }
-            let o = &self.scene.objects[i as usize];
+            let o = &self.scene.objects[p.object as usize];
             let a = Vec3::from_slice(&o.a);
-            let rays = self.rays;
             match o.kind {
-                KIND_MESH => {
-                    let root = self.bvh.mesh_roots[i as usize];
-                    self.tree(stacks, root, lanes, hits, &Mesh(i));
-                }
                 KIND_QUAD => {
                     let quad = Quad(a, Vec3::from_slice(&o.b), Vec3::from_slice(&o.c));
-                    hits.test(rays, lanes, i, 0, &quad);
+                    hits.test(rays, lanes, p.object, 0, &quad);
                 }
-                KIND_SPHERE => hits.test(rays, lanes, i, 0, &Sphere(a, o.a[3])),
+                KIND_SPHERE => hits.test(rays, lanes, p.object, 0, &Sphere(a, o.a[3])),
                 _ => {
                     let caps = o.flags & FLAG_CAPS != 0;
                     let cylinder = Cylinder(a, Vec3::from_slice(&o.b), o.a[3], caps);
-                    hits.test(rays, lanes, i, 0, &cylinder);
+                    hits.test(rays, lanes, p.object, 0, &cylinder);
                 }
             }
-            self.stop_found(hits);
-        }
-    }
-
-    /// Tests the triangles `range` of mesh object `object` with the rays `lanes`.
-    #[inline(always)]
-    fn triangles(&self, object: u32, range: Range<u32>, lanes: Lanes, hits: &mut PacketHits) {
-        for tri in range {
-            let triangle = Triangle(self.bvh.triangles[tri as usize]);
-            hits.test(self.rays, lanes & hits.searching, object, tri, &triangle);
         }
         self.stop_found(hits);
     }
@@ -494,17 +414,9 @@ impl PacketWalk<'_> {
         }
     }
 
-    /// Ray `lane` walks the subtree at `node` alone: of the top level, or of mesh `mesh`'s
-    /// tree.
+    /// Ray `lane` walks the subtree at `node` alone.
     #[inline(always)]
-    fn alone(
-        &self,
-        stacks: &mut Stacks,
-        lane: usize,
-        node: u32,
-        hits: &mut PacketHits,
-        mesh: Option<u32>,
-    ) {
+    fn alone(&self, stacks: &mut Stacks, lane: usize, node: u32, hits: &mut PacketHits) {
         let ray = self.rays.ray(lane);
         let lanes = RayLanes::new(&ray);
         let walk = Walk {
@@ -516,14 +428,7 @@ impl PacketWalk<'_> {
         };
         let mut hit = hits.get(lane);
         stacks.single.clear();
-        match mesh {
-            None => walk.tree(stacks.single, node, &mut hit, |stack, range, hit| {
-                walk.objects(stack, range, hit)
-            }),
-            Some(object) => walk.tree(stacks.single, node, &mut hit, |_, range, hit| {
-                walk.triangles(object, range, hit)
-            }),
-        };
+        walk.tree(stacks.single, node, &mut hit);
         hits.set(lane, hit);
         if self.any_hit && hit.object != u32::MAX {
             hits.searching &= !(1 << lane);

@@ -1,11 +1,11 @@
 //! Ray queries on a [`GpuScene`] on the CPU: the twin of `intersect.wgsl` and of the
 //! primitive tests of `bvh.wgsl` (same names, same arithmetic), and a walk of the binary
-//! trees, used for picking and as the reference the 4-wide walks are checked against.
+//! tree, used for picking and as the reference the 4-wide walks are checked against.
 
 use glam::{Vec3, Vec3A};
 
 use crate::accel::GpuScene;
-use crate::gpu::{FLAG_CAPS, GpuBvhNode, KIND_MESH, KIND_QUAD, KIND_SPHERE};
+use crate::gpu::{FLAG_CAPS, GpuBvhNode, KIND_QUAD, KIND_SPHERE, NO_TRIANGLE};
 
 /// Distance returned when there is no hit (WGSL `MISS`).
 pub const MISS: f32 = 3.0e38;
@@ -24,7 +24,7 @@ pub struct Ray {
 pub struct Hit {
     /// Distance along the ray.
     pub t: f32,
-    /// Index into [`GpuScene::objects`] (top-level order).
+    /// Index into [`GpuScene::objects`] (the scene's order).
     pub object: u32,
     /// Mesh: triangle index; other shapes: 0.
     pub primitive: u32,
@@ -204,17 +204,6 @@ pub fn intersect_triangle_edges(
     (t, b1, b2)
 }
 
-/// A traversal stack entry (WGSL packs these into tagged `u32`s).
-#[derive(Debug, Clone, Copy)]
-enum Entry {
-    /// A node to visit.
-    Node(u32),
-    /// A mesh object whose BLAS is still to be walked (WGSL `ENTER_MESH`).
-    EnterMesh(u32),
-    /// The end of the BLAS being walked (WGSL `LEAVE_MESH`).
-    LeaveMesh,
-}
-
 impl GpuScene {
     /// Triangle `i`'s corner positions.
     pub fn triangle(&self, i: u32) -> [Vec3; 3] {
@@ -222,8 +211,8 @@ impl GpuScene {
         [0, 1, 2].map(|k| Vec3::from(self.vertices[i + k].position))
     }
 
-    /// Nearest hit on quad, sphere or cylinder `i` (top-level order), updating `hit`; twin
-    /// of WGSL `intersect_shape`.
+    /// Nearest hit on quad, sphere or cylinder object `i`, updating `hit`; twin of WGSL
+    /// `intersect_shape`.
     #[inline(always)]
     pub fn intersect_shape(&self, i: u32, ray: &Ray, hit: &mut Hit) {
         let o = &self.objects[i as usize];
@@ -254,58 +243,47 @@ impl GpuScene {
         }
     }
 
-    /// Nearest hit among triangles `first .. first + count` of mesh object `object`; twin of
-    /// WGSL `intersect_triangles`.
-    fn intersect_triangles(&self, object: u32, first: u32, count: u32, ray: &Ray, hit: &mut Hit) {
-        for tri in first..first + count {
-            let [v0, v1, v2] = self.triangle(tri);
-            let (t, b1, b2) = intersect_triangle(v0, v1, v2, ray, hit.t);
-            if t < hit.t {
-                *hit = Hit {
-                    t,
-                    object,
-                    primitive: tri,
-                    b1,
-                    b2,
-                };
-            }
+    /// Nearest hit on primitive `i` (a shape or a triangle), updating `hit`; twin of WGSL
+    /// `intersect_primitive`.
+    #[inline(always)]
+    pub fn intersect_primitive(&self, i: u32, ray: &Ray, hit: &mut Hit) {
+        let p = &self.primitives[i as usize];
+        if p.triangle == NO_TRIANGLE {
+            self.intersect_shape(p.object, ray, hit);
+            return;
+        }
+        let [v0, e1, e2] = [p.v0, p.e1, p.e2].map(Vec3::from);
+        let (t, b1, b2) = intersect_triangle_edges(v0, e1, e2, ray, hit.t);
+        if t < hit.t {
+            *hit = Hit {
+                t,
+                object: p.object,
+                primitive: p.triangle,
+                b1,
+                b2,
+            };
         }
     }
 
-    /// Nearest hit in `(0, t_max)`, or with `any_hit` the first one found: one ordered
-    /// stack walk over both levels of the binary trees.
+    /// Nearest hit in `(0, t_max)`, or with `any_hit` the first one found: an ordered stack
+    /// walk of the binary tree.
     fn trace(&self, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
         let mut hit = Hit::none(t_max);
         let nodes = &self.nodes;
         let inv_dir = safe_inverse(ray.dir);
-        if self.object_count == 0 || intersect_aabb(&nodes[0], ray.origin, inv_dir, hit.t) == MISS {
+        if self.primitives.is_empty()
+            || intersect_aabb(&nodes[0], ray.origin, inv_dir, hit.t) == MISS
+        {
             return hit;
         }
-        let mut stack: Vec<(Entry, f32)> = Vec::with_capacity(64);
+        // Nodes still to visit, with the distances at which the ray enters their boxes.
+        let mut stack: Vec<(u32, f32)> = Vec::with_capacity(64);
         let mut index = 0u32;
-        // The mesh whose BLAS is being walked, if any.
-        let mut mesh: Option<u32> = None;
         loop {
             let node = &nodes[index as usize];
-            let mut descend = false;
             if node.prim_count > 0 {
-                let (first, count) = (node.first_index, node.prim_count);
-                match mesh {
-                    Some(object) => self.intersect_triangles(object, first, count, ray, &mut hit),
-                    None => {
-                        for i in first..first + count {
-                            let o = &self.objects[i as usize];
-                            if o.kind != KIND_MESH {
-                                self.intersect_shape(i, ray, &mut hit);
-                            } else {
-                                let root = &nodes[o.blas_root as usize];
-                                let t = intersect_aabb(root, ray.origin, inv_dir, hit.t);
-                                if t != MISS {
-                                    stack.push((Entry::EnterMesh(i), t));
-                                }
-                            }
-                        }
-                    }
+                for i in node.first_index..node.first_index + node.prim_count {
+                    self.intersect_primitive(i, ray, &mut hit);
                 }
                 if any_hit && hit.object != u32::MAX {
                     break;
@@ -317,37 +295,16 @@ impl GpuScene {
                 if ta != MISS && tb != MISS {
                     let (near, far) = if ta <= tb { (a, a + 1) } else { (a + 1, a) };
                     index = near;
-                    stack.push((Entry::Node(far), ta.max(tb)));
-                    descend = true;
+                    stack.push((far, ta.max(tb)));
+                    continue;
                 } else if ta != MISS || tb != MISS {
                     index = if ta != MISS { a } else { a + 1 };
-                    descend = true;
+                    continue;
                 }
             }
-            if !descend {
-                let mut found = false;
-                while let Some((entry, t)) = stack.pop() {
-                    match entry {
-                        Entry::LeaveMesh => mesh = None,
-                        _ if t >= hit.t => {}
-                        Entry::EnterMesh(object) => {
-                            mesh = Some(object);
-                            index = self.objects[object as usize].blas_root;
-                            stack.push((Entry::LeaveMesh, 0.0));
-                            found = true;
-                            break;
-                        }
-                        Entry::Node(node) => {
-                            index = node;
-                            found = true;
-                            break;
-                        }
-                    }
-                }
-                if !found {
-                    break;
-                }
-            }
+            let next = std::iter::from_fn(|| stack.pop()).find(|&(_, t)| t < hit.t);
+            let Some((node, _)) = next else { break };
+            index = node;
         }
         hit
     }

@@ -1,5 +1,5 @@
-//! The acceleration structure both backends walk: [`GpuScene`]'s binary BVHs collapsed into
-//! 4-wide ones, whose four child boxes are tested at once (in SIMD lanes on the CPU, glam's
+//! The acceleration structure both backends walk: [`GpuScene`]'s binary BVH collapsed into a
+//! 4-wide one, whose four child boxes are tested at once (in SIMD lanes on the CPU, glam's
 //! `Vec4`; as `vec4f`s by WGSL `trace_scene` in `bvh.wgsl`, which reads [`GpuWideNode`]s).
 //!
 //! A ray visits about half as many nodes as in the binary tree and tests their children in
@@ -7,16 +7,14 @@
 //! only the order of the walk differs (which can change the answer between two primitives at
 //! exactly the same distance).
 
-use std::ops::Range;
-
 use bytemuck::Zeroable;
-use glam::{Vec3, Vec4};
+use glam::Vec4;
 use obvhs::aabb::Aabb;
 
 use crate::accel::GpuScene;
-use crate::gpu::{GpuBvhNode, GpuObject, GpuTriangle, GpuWideNode, KIND_MESH};
+use crate::gpu::{GpuBvhNode, GpuWideNode, NO_TRIANGLE, SHAPE_LEAF};
 use crate::packet::Lanes;
-use crate::trace::{Hit, Ray, intersect_triangle_edges, safe_inverse};
+use crate::trace::{Hit, Ray, safe_inverse};
 
 /// Four child boxes in structure-of-arrays form, and what each child is.
 #[derive(Debug, Clone, Copy)]
@@ -32,18 +30,13 @@ pub(crate) struct Node4 {
     pub count: [u32; 4],
 }
 
-/// A 4-wide BVH over a [`GpuScene`]: one tree over the objects and one per mesh.
+/// A 4-wide BVH over a [`GpuScene`]'s primitives.
 #[derive(Debug, Clone, Default)]
 pub struct WideBvh {
-    /// Every tree's nodes; the top level's root is node 0 (when there are objects).
+    /// The nodes, root at 0; empty when the scene has no primitives.
     pub(crate) nodes: Vec<Node4>,
-    /// Per object of the scene: the root of its mesh's tree (unused for other shapes).
-    pub(crate) mesh_roots: Vec<u32>,
-    /// Per triangle: its first corner and the two edges from it (`intersect_triangle`'s
-    /// subtractions done once, with the same results).
-    pub(crate) triangles: Vec<[Vec3; 3]>,
-    /// Whether the scene has any object.
-    pub(crate) has_objects: bool,
+    /// Per leaf primitive: whether it is a whole shape rather than a triangle.
+    pub(crate) is_shape: Vec<bool>,
 }
 
 /// A node still to visit, and the distance at which the ray enters its box.
@@ -98,40 +91,43 @@ impl RayLanes {
 }
 
 impl WideBvh {
-    /// Collapses the binary trees of `scene` (its top level and every mesh's BLAS).
+    /// Collapses the binary tree of `scene`.
     pub fn build(scene: &GpuScene) -> Self {
         let mut bvh = Self {
-            has_objects: scene.object_count > 0,
+            is_shape: scene
+                .primitives
+                .iter()
+                .map(|p| p.triangle == NO_TRIANGLE)
+                .collect(),
             ..Self::default()
         };
-        if bvh.has_objects {
+        if !scene.primitives.is_empty() {
             bvh.collapse(&scene.nodes, 0);
         }
-        bvh.mesh_roots = scene
-            .objects
-            .iter()
-            .map(|o| {
-                if o.kind == KIND_MESH {
-                    bvh.collapse(&scene.nodes, o.blas_root)
-                } else {
-                    0
-                }
-            })
-            .collect();
-        bvh.triangles = (0..(scene.vertices.len() / 3) as u32)
-            .map(|i| {
-                let [v0, v1, v2] = scene.triangle(i);
-                [v0, v1 - v0, v2 - v0]
-            })
-            .collect();
         bvh
     }
 
-    /// The nodes in the layout the GPU reads. Never empty (a placeholder when there are no
-    /// objects).
+    /// Whether the leaf of `count` primitives from `first` holds a shape.
+    fn holds_shape(&self, first: u32, count: u32) -> bool {
+        self.is_shape[first as usize..(first + count) as usize]
+            .iter()
+            .any(|&s| s)
+    }
+
+    /// The nodes in the layout the GPU reads, leaves holding shapes marked [`SHAPE_LEAF`].
+    /// Never empty: without primitives, one node of four unused children, which no ray
+    /// enters.
     pub fn gpu_nodes(&self) -> Vec<GpuWideNode> {
         if self.nodes.is_empty() {
-            return vec![GpuWideNode::zeroed()];
+            return vec![GpuWideNode {
+                lo_x: [f32::INFINITY; 4],
+                lo_y: [f32::INFINITY; 4],
+                lo_z: [f32::INFINITY; 4],
+                hi_x: [f32::NEG_INFINITY; 4],
+                hi_y: [f32::NEG_INFINITY; 4],
+                hi_z: [f32::NEG_INFINITY; 4],
+                ..GpuWideNode::zeroed()
+            }];
         }
         self.nodes
             .iter()
@@ -143,91 +139,42 @@ impl WideBvh {
                 hi_y: n.hi[1].to_array(),
                 hi_z: n.hi[2].to_array(),
                 first: n.first,
-                count: n.count,
+                count: [0, 1, 2, 3].map(|lane| {
+                    let (first, count) = (n.first[lane], n.count[lane]);
+                    if count > 0 && self.holds_shape(first, count) {
+                        count | SHAPE_LEAF
+                    } else {
+                        count
+                    }
+                }),
             })
             .collect()
     }
 
-    /// The triangles as the GPU reads them. Never empty (a placeholder when there are none).
-    pub fn gpu_triangles(&self) -> Vec<GpuTriangle> {
-        if self.triangles.is_empty() {
-            return vec![GpuTriangle::zeroed()];
-        }
-        self.triangles
-            .iter()
-            .map(|[v0, e1, e2]| GpuTriangle {
-                v0: v0.to_array(),
-                e1: e1.to_array(),
-                e2: e2.to_array(),
-                ..GpuTriangle::zeroed()
-            })
-            .collect()
-    }
-
-    /// `scene`'s objects as the GPU reads them: a mesh's `blas_root` is the root of its tree
-    /// here instead of in the binary nodes.
-    pub fn gpu_objects(&self, scene: &GpuScene) -> Vec<GpuObject> {
-        scene
-            .objects
-            .iter()
-            .zip(&self.mesh_roots)
-            .map(|(o, &root)| GpuObject {
-                blas_root: if o.kind == KIND_MESH { root } else { 0 },
-                ..*o
-            })
-            .collect()
-    }
-
-    /// Most entries the traversal stack of WGSL `trace_scene` can hold at once for `scene`
-    /// (from which this tree was built). At each node the walk pushes the entered children
-    /// still to visit but the nearest (inner ones in the top level, whose leaves it tests at
-    /// once, pushing their meshes; leaves too in a mesh's tree), and the stack holds only the
-    /// pending entries of the current node and its ancestors; a mesh's tree is walked above
-    /// the marker that replaces its entry. The integrator's stack is sized from it.
-    pub fn stack_bound(&self, scene: &GpuScene) -> u32 {
-        if !self.has_objects {
+    /// Most entries the traversal stack of WGSL `trace_scene` can hold at once. At each node
+    /// the walk tests the entered leaves that hold shapes at once and pushes the other
+    /// entered children but the nearest, and the stack holds only the pending entries of
+    /// the current node and its ancestors. The integrator's stack is sized from it.
+    pub fn stack_bound(&self) -> u32 {
+        if self.nodes.is_empty() {
             return 1;
         }
-        let meshes_in = |first: u32, count: u32| {
-            (first..first + count)
-                .filter(|&i| scene.objects[i as usize].kind == KIND_MESH)
-                .count() as u32
-        };
-        let top = self.path_pushes(0, Some(&meshes_in));
-        let mesh = scene.objects[..scene.object_count as usize]
-            .iter()
-            .zip(&self.mesh_roots)
-            .filter(|(o, _)| o.kind == KIND_MESH)
-            .map(|(_, &root)| self.path_pushes(root, None))
-            .max()
-            .unwrap_or(0);
-        top + mesh + 1
+        self.path_pushes(0) + 1
     }
 
-    /// Most entries pushed along one path down from `node`. With `tested_leaves` a node's
-    /// leaves are tested when it is visited, a leaf of `count` primitives from `first`
-    /// pushing `tested_leaves(first, count)` entries; without, leaves are pushed like inner
-    /// children.
-    fn path_pushes(&self, node: u32, tested_leaves: Option<&dyn Fn(u32, u32) -> u32>) -> u32 {
+    /// Most entries pushed along one path down from `node`.
+    fn path_pushes(&self, node: u32) -> u32 {
         let n = &self.nodes[node as usize];
         let used = (0..4).filter(|&lane| n.lo[0][lane] <= n.hi[0][lane]);
-        let (inner, leaves): (Vec<usize>, Vec<usize>) = used.partition(|&lane| n.count[lane] == 0);
-        let at_node = match tested_leaves {
-            Some(pushes) => {
-                leaves
-                    .iter()
-                    .map(|&lane| pushes(n.first[lane], n.count[lane]))
-                    .sum::<u32>()
-                    + (inner.len() as u32).saturating_sub(1)
-            }
-            None => (inner.len() + leaves.len()).saturating_sub(1) as u32,
-        };
-        let below = inner
-            .iter()
-            .map(|&lane| self.path_pushes(n.first[lane], tested_leaves))
+        let pushed = used
+            .filter(|&lane| n.count[lane] == 0 || !self.holds_shape(n.first[lane], n.count[lane]))
+            .count() as u32;
+        let below = (0..4)
+            .filter(|&lane| n.lo[0][lane] <= n.hi[0][lane] && n.count[lane] == 0)
+            .map(|lane| self.path_pushes(n.first[lane]))
             .max()
             .unwrap_or(0);
-        at_node + below
+        pushed.saturating_sub(1) + below
     }
 
     /// Appends the 4-wide form of the binary subtree at `root`; returns its node index.
@@ -323,7 +270,7 @@ impl<'a> Tracer<'a> {
     #[inline(always)]
     fn trace(&mut self, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
         let mut hit = Hit::none(t_max);
-        if self.bvh.has_objects {
+        if !self.bvh.nodes.is_empty() {
             let lanes = RayLanes::new(ray);
             self.stack.clear();
             let walk = Walk {
@@ -333,9 +280,7 @@ impl<'a> Tracer<'a> {
                 lanes: &lanes,
                 any_hit,
             };
-            walk.tree(&mut self.stack, 0, &mut hit, |stack, range, hit| {
-                walk.objects(stack, range, hit)
-            });
+            walk.tree(&mut self.stack, 0, &mut hit);
         }
         hit
     }
@@ -356,17 +301,11 @@ pub(crate) struct Walk<'a> {
 }
 
 impl Walk<'_> {
-    /// Walks the tree at `root`, nearest boxes first, using `stack` above its current
-    /// length. Leaves go to `leaf` as their node is visited (nearest first); inner nodes are
-    /// pushed. Returns false as soon as `leaf` does (an any-hit query has its answer).
+    /// Walks the subtree at `root`, nearest boxes first, using `stack` above its
+    /// current length. A node's entered leaves are tested as it is visited (nearest first);
+    /// inner nodes are pushed. An any-hit query stops at its first hit.
     #[inline(always)]
-    pub(crate) fn tree(
-        &self,
-        stack: &mut Vec<Entry>,
-        root: u32,
-        hit: &mut Hit,
-        mut leaf: impl FnMut(&mut Vec<Entry>, Range<u32>, &mut Hit) -> bool,
-    ) -> bool {
+    pub(crate) fn tree(&self, stack: &mut Vec<Entry>, root: u32, hit: &mut Hit) {
         let base = stack.len();
         let mut node = root;
         loop {
@@ -389,9 +328,11 @@ impl Walk<'_> {
             }
             for &(t, lane) in &order[..entered] {
                 if n.count[lane] > 0 && t < hit.t {
-                    let (first, count) = (n.first[lane], n.count[lane]);
-                    if !leaf(stack, first..first + count, hit) {
-                        return false;
+                    for i in n.first[lane]..n.first[lane] + n.count[lane] {
+                        self.scene.intersect_primitive(i, self.ray, hit);
+                    }
+                    if self.any_hit && hit.object != u32::MAX {
+                        return;
                     }
                 }
             }
@@ -405,10 +346,10 @@ impl Walk<'_> {
             }
             loop {
                 if stack.len() == base {
-                    return true;
+                    return;
                 }
                 let Some(entry) = stack.pop() else {
-                    return true;
+                    return;
                 };
                 if entry.t < hit.t {
                     node = entry.node;
@@ -416,45 +357,5 @@ impl Walk<'_> {
                 }
             }
         }
-    }
-
-    /// Tests the top-level objects `range`, walking the tree of each mesh among them.
-    /// Returns false once an any-hit query has its answer.
-    #[inline(always)]
-    pub(crate) fn objects(&self, stack: &mut Vec<Entry>, range: Range<u32>, hit: &mut Hit) -> bool {
-        for i in range {
-            if self.scene.objects[i as usize].kind == KIND_MESH {
-                let root = self.bvh.mesh_roots[i as usize];
-                let found = !self.tree(stack, root, hit, |_, triangles, hit| {
-                    self.triangles(i, triangles, hit)
-                });
-                if found {
-                    return false;
-                }
-            } else {
-                self.scene.intersect_shape(i, self.ray, hit);
-            }
-        }
-        !(self.any_hit && hit.object != u32::MAX)
-    }
-
-    /// Tests the triangles `range` of mesh object `object`. Returns false once an any-hit
-    /// query has its answer.
-    #[inline(always)]
-    pub(crate) fn triangles(&self, object: u32, range: Range<u32>, hit: &mut Hit) -> bool {
-        for tri in range {
-            let [v0, e1, e2] = self.bvh.triangles[tri as usize];
-            let (t, b1, b2) = intersect_triangle_edges(v0, e1, e2, self.ray, hit.t);
-            if t < hit.t {
-                *hit = Hit {
-                    t,
-                    object,
-                    primitive: tri,
-                    b1,
-                    b2,
-                };
-            }
-        }
-        !(self.any_hit && hit.object != u32::MAX)
     }
 }

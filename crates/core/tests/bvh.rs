@@ -3,7 +3,7 @@
 //! random, empty and degenerate scenes.
 
 use glam::{Vec2, Vec3};
-use pathlight_core::gpu::{GpuBvhNode, KIND_MESH};
+use pathlight_core::gpu::{GpuBvhNode, KIND_MESH, NO_TRIANGLE};
 use pathlight_core::packet::{Lanes, PACKET, RayPacket};
 use pathlight_core::scene::{Camera, Lobes, Material, RenderSettings, TriangleMesh};
 use pathlight_core::trace::{Hit, Ray, intersect_triangle};
@@ -102,18 +102,15 @@ fn random_objects(rng: &mut StdRng, count: usize) -> Vec<Object> {
         .collect()
 }
 
-/// Every node's box holds its children or primitives; every primitive is in exactly one leaf.
+/// Every node's box holds its children or primitives; every primitive is in exactly one
+/// leaf; every shape and every mesh triangle is exactly one primitive, a triangle one with
+/// the vertex buffer's corners and its mesh's triangle range.
 fn validate(gpu: &GpuScene) {
     fn contains(outer: &GpuBvhNode, min: Vec3, max: Vec3) -> bool {
         Vec3::from(outer.aabb_min).cmple(min + 1e-4).all()
             && Vec3::from(outer.aabb_max).cmpge(max - 1e-4).all()
     }
-    fn walk(
-        gpu: &GpuScene,
-        index: u32,
-        seen: &mut Vec<u32>,
-        leaf: &mut dyn FnMut(&GpuBvhNode, u32, &mut Vec<u32>),
-    ) {
+    fn walk(gpu: &GpuScene, index: u32, leaf: &mut dyn FnMut(&GpuBvhNode, u32)) {
         let node = gpu.nodes[index as usize];
         if node.prim_count == 0 {
             for child in [node.first_index, node.first_index + 1] {
@@ -122,35 +119,72 @@ fn validate(gpu: &GpuScene) {
                     contains(&node, c.aabb_min.into(), c.aabb_max.into()),
                     "child {child} escapes node {index}"
                 );
-                walk(gpu, child, seen, leaf);
+                walk(gpu, child, leaf);
             }
         } else {
             for p in node.first_index..node.first_index + node.prim_count {
-                leaf(&node, p, seen);
+                leaf(&node, p);
             }
         }
     }
-    let mut seen_objects = Vec::new();
-    walk(gpu, 0, &mut seen_objects, &mut |_, p, seen| seen.push(p));
-    seen_objects.sort_unstable();
-    assert_eq!(seen_objects, (0..gpu.object_count).collect::<Vec<_>>());
-    for object in gpu.objects.iter().filter(|o| o.kind == KIND_MESH) {
-        let mut seen = Vec::new();
-        walk(gpu, object.blas_root, &mut seen, &mut |node, tri, seen| {
-            for v in gpu.triangle(tri) {
-                assert!(contains(node, v, v), "triangle {tri} escapes its leaf");
+    let mut seen = Vec::new();
+    if !gpu.primitives.is_empty() {
+        walk(gpu, 0, &mut |node, p| {
+            let prim = gpu.primitives[p as usize];
+            let owner = gpu.objects[prim.object as usize];
+            if prim.triangle == NO_TRIANGLE {
+                assert_ne!(owner.kind, KIND_MESH, "primitive {p}: a mesh as a shape");
+            } else {
+                let tri = prim.triangle;
+                assert!(
+                    owner.kind == KIND_MESH
+                        && (owner.first_triangle..owner.first_triangle + owner.triangle_count)
+                            .contains(&tri),
+                    "primitive {p}: triangle {tri} outside its mesh's range"
+                );
+                let [v0, v1, v2] = gpu.triangle(tri);
+                assert_eq!(
+                    [prim.v0, prim.e1, prim.e2],
+                    [v0, v1 - v0, v2 - v0].map(|v| v.to_array()),
+                    "primitive {p}: not triangle {tri}'s corner and edges"
+                );
+                for v in [v0, v1, v2] {
+                    assert!(contains(node, v, v), "triangle {tri} escapes its leaf");
+                }
             }
-            seen.push(tri);
+            seen.push(p);
         });
-        seen.sort_unstable();
-        seen.dedup();
-        let count = seen.len();
-        assert_eq!(
-            seen.last().unwrap() - seen[0] + 1,
-            count as u32,
-            "BLAS leaves are not one contiguous range"
-        );
     }
+    seen.sort_unstable();
+    assert_eq!(seen, (0..gpu.primitives.len() as u32).collect::<Vec<_>>());
+    let mut shapes: Vec<u32> = gpu
+        .primitives
+        .iter()
+        .filter(|p| p.triangle == NO_TRIANGLE)
+        .map(|p| p.object)
+        .collect();
+    shapes.sort_unstable();
+    let expected: Vec<u32> = (0..gpu.object_count)
+        .filter(|&i| gpu.objects[i as usize].kind != KIND_MESH)
+        .collect();
+    assert_eq!(shapes, expected, "every shape is one primitive");
+    let mut triangles: Vec<u32> = gpu
+        .primitives
+        .iter()
+        .filter(|p| p.triangle != NO_TRIANGLE)
+        .map(|p| p.triangle)
+        .collect();
+    triangles.sort_unstable();
+    let triangle_count = gpu.objects[..gpu.object_count as usize]
+        .iter()
+        .filter(|o| o.kind == KIND_MESH)
+        .map(|o| o.triangle_count)
+        .sum::<u32>();
+    assert_eq!(
+        triangles,
+        (0..triangle_count).collect::<Vec<_>>(),
+        "every triangle is one primitive"
+    );
 }
 
 /// The nearest hit over every object and every triangle, without the BVH.
@@ -304,7 +338,7 @@ fn assert_same(gpu: &GpuScene, rays: &[Ray]) -> usize {
     hits
 }
 
-/// A ray towards a random point of the top-level root's box.
+/// A ray towards a random point of the root's box.
 fn ray_into_root_box(rng: &mut StdRng, gpu: &GpuScene) -> Ray {
     let root = gpu.nodes[0];
     let (min, max) = (Vec3::from(root.aabb_min), Vec3::from(root.aabb_max));

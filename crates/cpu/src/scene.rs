@@ -11,7 +11,7 @@ use pathlight_core::gpu::{GpuObject, KIND_QUAD};
 pub struct CpuScene {
     /// The buffers the WGSL twin reads.
     pub gpu: GpuScene,
-    /// Per object (top-level order): a quad's unit normal and area; zero for other kinds.
+    /// Per object: a quad's unit normal and area; zero for other kinds.
     quads: Vec<(Vec3, f32)>,
 }
 

@@ -1,14 +1,13 @@
-// Two-level 4-wide BVH traversal: the top level over objects, a tree per mesh, all in
-// `nodes` (`WideNode`s collapsed from obvhs BVH2s: `crates/core/src/wide_bvh.rs`). Ordered
-// depth-first with one explicit stack for both levels. At each node the four child boxes are
-// tested at once. In the top level the entered leaves' shapes are tested at once and a
-// leaf's mesh is pushed as an ENTER_MESH entry; popping it pushes a LEAVE_MESH marker and
-// walks the mesh's tree, whose entries all lie above the marker. The nearest entered child
-// still to visit (inner, or in a mesh's tree a leaf too) is taken next and the others are
-// pushed with their entry distances, nearest on top, to be skipped on pop if a closer hit
-// was found meanwhile. Shadow rays stop at the first hit. CPU twin: `Walk::tree` in
-// `crates/core/src/wide_bvh.rs` (which tests a node's leaves as it visits the node; the hits
-// are the same).
+// 4-wide BVH traversal over every primitive of the scene (`nodes`: `WideNode`s collapsed
+// from an obvhs BVH2, `crates/core/src/wide_bvh.rs`; leaves index `primitives`: shapes and
+// the triangles of every mesh). Ordered depth-first with one explicit stack. At each node the
+// four child boxes are tested at once. The entered leaves that hold shapes (SHAPE_LEAF) are
+// tested at once; the other entered children (inner nodes, leaves of triangles as LEAF
+// entries) are sorted, the nearest is taken next and the others are pushed with their entry
+// distances, nearest on top, to be skipped on pop if a closer hit was found meanwhile.
+// Leaves of triangles are tested in a loop of their own. Shadow rays stop at the first hit.
+// CPU twin: `Walk::tree` in `crates/core/src/wide_bvh.rs` (which tests a node's leaves as it
+// visits the node; the hits are the same).
 //
 // `ACCEL` (a pipeline constant) selects the seed's slower schemes for benchmarks: every object
 // in turn, a mesh's triangles tested only when the ray hits the mesh's bounding box
@@ -21,29 +20,24 @@ override ACCEL: u32 = 0u;
 
 const STACK_SIZE: u32 = 64u;
 const NO_HIT: u32 = 0xffffffffu;
-// Stack entry tags (an untagged entry is an inner node): an object whose tree is still to be
-// walked (its index in the low bits), a leaf child (node << 2 | lane in the low bits: the
-// host refuses trees of 2^28 nodes or more), and
-// the end of the mesh tree being walked.
-const ENTER_MESH: u32 = 0x80000000u;
-const LEAF: u32 = 0x40000000u;
-const ENTRY_TAG: u32 = 0xc0000000u;
-const LEAVE_MESH: u32 = 0xffffffffu;
+// Stack entry tag (an untagged entry is an inner node): a leaf child, node << 2 | lane in
+// the low bits (the host refuses trees of 2^28 nodes or more).
+const LEAF: u32 = 0x80000000u;
 // No node left to visit.
 const NO_NODE: u32 = 0xffffffffu;
 
 struct Hit {
     t: f32,
-    // Index into `objects` (top-level order), or NO_HIT.
+    // Index into `objects`, or NO_HIT.
     object: u32,
-    // Mesh: triangle index; other shapes: 0.
+    // Mesh: triangle index in `vertices`; other shapes: 0.
     primitive: u32,
     // Triangle: barycentrics of vertices 1 and 2; quad: (s, t).
     b1: f32,
     b2: f32,
 }
 
-// Nearest hit on quad, sphere or cylinder `i` (top-level order), updating `hit`.
+// Nearest hit on quad, sphere or cylinder object `i`, updating `hit`.
 fn intersect_shape(i: u32, o: Object, ray: Ray, hit: ptr<function, Hit>) {
     switch o.kind {
         case KIND_QUAD: {
@@ -67,13 +61,39 @@ fn intersect_shape(i: u32, o: Object, ray: Ray, hit: ptr<function, Hit>) {
     }
 }
 
-// Nearest hit among triangles `first .. first + count` of mesh object `object`.
-fn intersect_triangles(object: u32, first: u32, count: u32, ray: Ray, hit: ptr<function, Hit>) {
+// Nearest hit on primitive `i`, a shape or a triangle, updating `hit`.
+fn intersect_primitive(i: u32, ray: Ray, hit: ptr<function, Hit>) {
+    let p = primitives[i];
+    if p.triangle == NO_TRIANGLE {
+        intersect_shape(p.object, objects[p.object], ray, hit);
+        return;
+    }
+    let r = intersect_triangle_edges(p.v0, p.e1, p.e2, ray, (*hit).t);
+    if r.x < (*hit).t {
+        *hit = Hit(r.x, p.object, p.triangle, r.y, r.z);
+    }
+}
+
+// Nearest hit among primitives `first .. first + count`, all triangles.
+fn intersect_triangles(first: u32, count: u32, ray: Ray, hit: ptr<function, Hit>) {
     for (var i = first; i < first + count; i++) {
-        let tri = triangles[i];
-        let r = intersect_triangle_edges(tri.v0, tri.e1, tri.e2, ray, (*hit).t);
+        let p = primitives[i];
+        let r = intersect_triangle_edges(p.v0, p.e1, p.e2, ray, (*hit).t);
         if r.x < (*hit).t {
-            *hit = Hit(r.x, object, i, r.y, r.z);
+            *hit = Hit(r.x, p.object, p.triangle, r.y, r.z);
+        }
+    }
+}
+
+// Nearest hit among the triangles of mesh object `i`, read from `vertices`.
+fn intersect_mesh(i: u32, o: Object, ray: Ray, hit: ptr<function, Hit>) {
+    for (var tri = o.first_triangle; tri < o.first_triangle + o.triangle_count; tri++) {
+        let v0 = vertices[3u * tri].position;
+        let e1 = vertices[3u * tri + 1u].position - v0;
+        let e2 = vertices[3u * tri + 2u].position - v0;
+        let r = intersect_triangle_edges(v0, e1, e2, ray, (*hit).t);
+        if r.x < (*hit).t {
+            *hit = Hit(r.x, i, tri, r.y, r.z);
         }
     }
 }
@@ -85,28 +105,13 @@ fn intersect_linear(ray: Ray, inv_dir: vec3f, object_count: u32, any_hit: bool, 
         if o.kind != KIND_MESH {
             intersect_shape(i, o, ray, hit);
         } else if ACCEL == ACCEL_BRUTE_FORCE
-            || intersect_aabb(tree_bounds(nodes[o.blas_root]), ray.origin, inv_dir, (*hit).t) != MISS {
-            intersect_triangles(i, o.first_triangle, o.triangle_count, ray, hit);
+            || intersect_aabb(Aabb(o.a.xyz, o.b.xyz), ray.origin, inv_dir, (*hit).t) != MISS {
+            intersect_mesh(i, o, ray, hit);
         }
         if any_hit && (*hit).object != NO_HIT {
             return;
         }
     }
-}
-
-// Box around the four children of `n` (the bounds of the tree it is the root of).
-fn tree_bounds(n: WideNode) -> Aabb {
-    let lo = vec3f(
-        min(min(n.lo_x.x, n.lo_x.y), min(n.lo_x.z, n.lo_x.w)),
-        min(min(n.lo_y.x, n.lo_y.y), min(n.lo_y.z, n.lo_y.w)),
-        min(min(n.lo_z.x, n.lo_z.y), min(n.lo_z.z, n.lo_z.w)),
-    );
-    let hi = vec3f(
-        max(max(n.hi_x.x, n.hi_x.y), max(n.hi_x.z, n.hi_x.w)),
-        max(max(n.hi_y.x, n.hi_y.y), max(n.hi_y.z, n.hi_y.w)),
-        max(max(n.hi_z.x, n.hi_z.y), max(n.hi_z.z, n.hi_z.w)),
-    );
-    return Aabb(lo, hi);
 }
 
 // Entry distances (clamped at 0) of the four child boxes of `n`, MISS for those the ray does
@@ -149,45 +154,37 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
         return hit;
     }
     let backwards = inv_dir < vec3f(0.0);
-    // Entries (node or tagged entry, bits of the entry distance), one 8-byte store each.
+    // Entries (node or LEAF entry, bits of the entry distance), one 8-byte store each.
     var stack: array<vec2u, STACK_SIZE>;
     var sp = 0u;
     var index = 0u;
-    // The mesh whose tree is being walked, or NO_HIT in the top level.
-    var mesh = NO_HIT;
     loop {
         let n = nodes[index];
         let t = enter_children(n, ray.origin, inv_dir, backwards, hit.t);
-        if mesh == NO_HIT {
-            // Top level: the entered leaves' shapes are tested now (cheaper than pushing
-            // them), a mesh is pushed as an ENTER_MESH entry.
+        // Entered leaves that hold shapes are tested now (cheaper than pushing them).
+        let at_once = (n.count & vec4u(SHAPE_LEAF)) != vec4u(0u);
+        if any(at_once & t < vec4f(hit.t)) {
             for (var lane = 0u; lane < 4u; lane++) {
-                let count = n.count[lane];
-                if count == 0u || t[lane] >= hit.t {
+                if !at_once[lane] || t[lane] >= hit.t {
                     continue;
                 }
                 let first = n.first[lane];
-                for (var i = first; i < first + count; i++) {
-                    let o = objects[i];
-                    if o.kind != KIND_MESH {
-                        intersect_shape(i, o, ray, &hit);
-                    } else if sp < STACK_SIZE {
-                        stack[sp] = vec2u(ENTER_MESH | i, bitcast<u32>(t[lane]));
-                        sp++;
-                    }
+                let end = first + (n.count[lane] & ~SHAPE_LEAF);
+                for (var i = first; i < end; i++) {
+                    intersect_primitive(i, ray, &hit);
                 }
             }
             if any_hit && hit.object != NO_HIT {
                 return hit;
             }
         }
-        // The children still to visit (in the top level its inner ones, in a mesh's tree
-        // leaves too, as LEAF entries) sorted by entry distance: a sorting network on four
-        // keys, MISS for those not entered before the current hit. The nearest is taken
-        // next, the others are pushed, farthest first.
+        // The other children still to visit (inner nodes, and leaves of triangles as LEAF
+        // entries) sorted by entry distance: a sorting network on four keys, MISS for those
+        // not entered before the current hit. The nearest is taken next, the others are
+        // pushed, farthest first.
         let leaves = vec4u(LEAF | (index << 2u)) | vec4u(0u, 1u, 2u, 3u);
         let entries = select(n.first, leaves, n.count != vec4u(0u));
-        let take = t < vec4f(hit.t) & (n.count == vec4u(0u) | vec4<bool>(mesh != NO_HIT));
+        let take = t < vec4f(hit.t) & !at_once;
         var k0 = select(MISS, t.x, take.x);
         var k1 = select(MISS, t.y, take.y);
         var k2 = select(MISS, t.z, take.z);
@@ -215,24 +212,24 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
         }
         var next = c0;
         if k0 == MISS {
-            next = pop_entry(&stack, &sp, &mesh, hit.t);
+            next = pop_entry(&stack, &sp, hit.t);
         }
-        // A mesh's leaves, nearest first, until the next inner node ("while-while", Aila and
-        // Laine: a warp's lanes intersect triangles together, then walk nodes together).
+        // Leaves of triangles, nearest first, until the next inner node ("while-while", Aila
+        // and Laine: a warp's lanes intersect triangles together, then walk nodes together).
         loop {
             if next == NO_NODE {
                 return hit;
             }
-            if (next & ENTRY_TAG) != LEAF {
+            if (next & LEAF) == 0u {
                 break;
             }
             let node = (next & ~LEAF) >> 2u;
             let lane = next & 3u;
-            intersect_triangles(mesh, nodes[node].first[lane], nodes[node].count[lane], ray, &hit);
+            intersect_triangles(nodes[node].first[lane], nodes[node].count[lane], ray, &hit);
             if any_hit && hit.object != NO_HIT {
                 return hit;
             }
-            next = pop_entry(&stack, &sp, &mesh, hit.t);
+            next = pop_entry(&stack, &sp, hit.t);
         }
         index = next;
     }
@@ -240,33 +237,14 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
 }
 
 // Pops the next entry whose subtree may hold a hit nearer than `t` and returns it (an inner
-// node or a LEAF entry), or NO_NODE when none is left; entering or leaving a mesh's tree on
-// the way updates `mesh`.
-fn pop_entry(
-    stack: ptr<function, array<vec2u, STACK_SIZE>>,
-    sp: ptr<function, u32>,
-    mesh: ptr<function, u32>,
-    t: f32,
-) -> u32 {
+// node or a LEAF entry), or NO_NODE when none is left.
+fn pop_entry(stack: ptr<function, array<vec2u, STACK_SIZE>>, sp: ptr<function, u32>, t: f32) -> u32 {
     while *sp > 0u {
         *sp -= 1u;
         let top = (*stack)[*sp];
-        let entry = top.x;
-        if entry == LEAVE_MESH {
-            *mesh = NO_HIT;
-            continue;
+        if bitcast<f32>(top.y) < t {
+            return top.x;
         }
-        if bitcast<f32>(top.y) >= t {
-            continue;
-        }
-        if (entry & ENTER_MESH) != 0u {
-            *mesh = entry & ~ENTER_MESH;
-            // The slot just freed holds the marker below the BLAS entries.
-            (*stack)[*sp].x = LEAVE_MESH;
-            *sp += 1u;
-            return objects[*mesh].blas_root;
-        }
-        return entry;
     }
     return NO_NODE;
 }

@@ -9,15 +9,13 @@ const KIND_MESH: u32 = 3u;
 const FLAG_FLAT: u32 = 1u;
 const FLAG_CAPS: u32 = 2u;
 
-// One object, a leaf of the top-level BVH. Host: `GpuObject`.
+// One object, in the scene's order (a mesh's box is `a.xyz` to `b.xyz`). Host: `GpuObject`.
 struct Object {
     a: vec4f,
     b: vec4f,
     c: vec4f,
     kind: u32,
     material: u32,
-    blas_root: u32,
-    id: u32,
     flags: u32,
     // First light-table entry, or NO_LIGHT; a mesh has one per triangle.
     light: u32,
@@ -25,6 +23,8 @@ struct Object {
     first_triangle: u32,
     // Mesh: how many triangles it has.
     triangle_count: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
 const NO_LIGHT: u32 = 0xffffffffu;
@@ -39,7 +39,7 @@ struct Light {
 
 // A node of the 4-wide BVH: its children's boxes per axis (an unused child's box is
 // inverted, +inf to -inf) and per child an inner node's index (count 0) or a leaf's
-// primitives first .. first + count (objects in the top level, triangles in a mesh's tree).
+// primitives first .. first + count, with SHAPE_LEAF set in count when one is not a triangle.
 // Host: `GpuWideNode`.
 struct WideNode {
     lo_x: vec4f,
@@ -60,16 +60,20 @@ struct Vertex {
     v: f32,
 }
 
-// A triangle for the intersection test: corner 0 and the edges to corners 1 and 2.
-// Host: `GpuTriangle`.
-struct Triangle {
+// A primitive of the BVH, in leaf order: a triangle for the intersection test (corner 0 and
+// the edges to corners 1 and 2; `triangle` is its index in `vertices`) or, with `triangle`
+// NO_TRIANGLE, the whole shape `object`. Host: `GpuPrimitive`.
+struct Primitive {
     v0: vec3f,
-    pad0: u32,
+    object: u32,
     e1: vec3f,
-    pad1: u32,
+    triangle: u32,
     e2: vec3f,
-    pad2: u32,
+    pad: u32,
 }
+
+const NO_TRIANGLE: u32 = 0xffffffffu;
+const SHAPE_LEAF: u32 = 0x80000000u;
 
 // Linear-RGB material with the seed's lobe weights. Host: `GpuMaterial`.
 struct Material {
@@ -106,5 +110,5 @@ struct TextureInfo {
 @group(0) @binding(4) var<storage, read> textures: array<TextureInfo>;
 @group(0) @binding(5) var<storage, read> texels: array<u32>;
 @group(0) @binding(6) var<storage, read> lights: array<Light>;
-// Triangle i of `vertices` for the intersection test.
-@group(0) @binding(7) var<storage, read> triangles: array<Triangle>;
+// The BVH's leaves index these.
+@group(0) @binding(7) var<storage, read> primitives: array<Primitive>;

@@ -26,7 +26,7 @@ const WORKGROUP: u32 = 8;
 /// it); the slower two reproduce the seed's frame-rate table (`pathlight bench --accel`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Accel {
-    /// The two-level BVH.
+    /// The BVH over every shape and triangle.
     #[default]
     Bvh,
     /// Every object in turn; a mesh's triangles only when the ray hits its bounding box.

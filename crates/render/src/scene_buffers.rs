@@ -1,5 +1,7 @@
 //! The scene on the device: the buffers of a [`GpuScene`] as bind group 0.
 
+use bytemuck::Zeroable;
+use pathlight_core::gpu::GpuPrimitive;
 use pathlight_core::{GpuScene, WideBvh};
 use wgpu::util::DeviceExt;
 
@@ -39,23 +41,29 @@ impl SceneBuffers {
     /// binding limit.
     pub fn upload(device: &wgpu::Device, scene: &GpuScene) -> Result<Self, RenderError> {
         let bvh = WideBvh::build(scene);
-        let (nodes, objects) = (bvh.gpu_nodes(), bvh.gpu_objects(scene));
+        let nodes = bvh.gpu_nodes();
         if nodes.len() >= MAX_NODES {
             return Err(RenderError::Limits(format!(
                 "the scene's BVH has {} nodes; the traversal addresses at most {MAX_NODES}",
                 nodes.len()
             )));
         }
-        let triangles = bvh.gpu_triangles();
+        // A binding is never empty: a placeholder when there are no primitives.
+        let placeholder = [GpuPrimitive::zeroed()];
+        let primitives = if scene.primitives.is_empty() {
+            &placeholder[..]
+        } else {
+            &scene.primitives
+        };
         let contents: [(&str, &[u8]); 8] = [
             ("bvh nodes", bytemuck::cast_slice(&nodes)),
-            ("objects", bytemuck::cast_slice(&objects)),
+            ("objects", bytemuck::cast_slice(&scene.objects)),
             ("vertices", bytemuck::cast_slice(&scene.vertices)),
             ("materials", bytemuck::cast_slice(&scene.materials)),
             ("texture table", bytemuck::cast_slice(&scene.textures)),
             ("texels", bytemuck::cast_slice(&scene.texels)),
             ("lights", bytemuck::cast_slice(&scene.lights)),
-            ("triangles", bytemuck::cast_slice(&triangles)),
+            ("primitives", bytemuck::cast_slice(primitives)),
         ];
         let limit = device.limits().max_storage_buffer_binding_size;
         let mut buffers = Vec::new();
@@ -84,7 +92,7 @@ impl SceneBuffers {
         Ok(Self {
             layout,
             bind_group,
-            stack_bound: bvh.stack_bound(scene),
+            stack_bound: bvh.stack_bound(),
         })
     }
 }

@@ -5,7 +5,7 @@
 pub const SCENE: &str = include_str!("../shaders/scene.wgsl");
 /// Ray-primitive intersection.
 pub const INTERSECT: &str = include_str!("../shaders/intersect.wgsl");
-/// Two-level 4-wide BVH traversal.
+/// 4-wide BVH traversal over every shape and triangle.
 pub const BVH: &str = include_str!("../shaders/bvh.wgsl");
 /// The sampler (Owen-scrambled Sobol, or hashed random numbers).
 pub const SAMPLER: &str = include_str!("../shaders/sampler.wgsl");

@@ -6,8 +6,8 @@ use std::mem::{offset_of, size_of};
 
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use pathlight_core::gpu::{
-    GpuAccumPixel, GpuBvhNode, GpuFrameParams, GpuLight, GpuMaterial, GpuObject, GpuTextureInfo,
-    GpuTriangle, GpuVertex, GpuWideNode,
+    GpuAccumPixel, GpuBvhNode, GpuFrameParams, GpuLight, GpuMaterial, GpuObject, GpuPrimitive,
+    GpuTextureInfo, GpuVertex, GpuWideNode,
 };
 use pathlight_render::display::GpuDisplayParams;
 use pathlight_render::shaders;
@@ -89,8 +89,6 @@ fn host_structs_match_their_wgsl_declarations() {
             c,
             kind,
             material,
-            blas_root,
-            id,
             flags,
             light,
             first_triangle,
@@ -105,7 +103,12 @@ fn host_structs_match_their_wgsl_declarations() {
         [lo_x, lo_y, lo_z, hi_x, hi_y, hi_z, first, count]
     );
     assert_layout!(m, "Vertex", GpuVertex, [position, u, normal, v]);
-    assert_layout!(m, "Triangle", GpuTriangle, [v0, pad0, e1, pad1, e2, pad2]);
+    assert_layout!(
+        m,
+        "Primitive",
+        GpuPrimitive,
+        [v0, object, e1, triangle, e2, pad]
+    );
     assert_layout!(
         m,
         "Material",

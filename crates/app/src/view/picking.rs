@@ -26,7 +26,7 @@ pub fn pick(scene: &Scene, gpu_scene: &GpuScene, x: f32, y: f32) -> Option<usize
         dir: dir.normalize(),
     };
     let hit = gpu_scene.intersect(&ray, 1e30)?;
-    Some(gpu_scene.objects[hit.object as usize].id as usize)
+    Some(hit.object as usize)
 }
 
 /// Turns objects into lights and back, remembering each one's own material.

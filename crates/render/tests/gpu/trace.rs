@@ -5,7 +5,7 @@
 use crate::common::context;
 use glam::Vec3;
 use pathlight_core::gpu::KIND_MESH;
-use pathlight_core::trace::Ray;
+use pathlight_core::trace::{Hit, MISS, Ray, intersect_triangle};
 use pathlight_core::{GpuScene, default_scene};
 use pathlight_render::Accel;
 use pathlight_render::scene_buffers::{SceneBuffers, create_compute_pipeline, storage_entry};
@@ -181,15 +181,9 @@ fn wgsl_traversal_matches_cpu_twin() {
 }
 
 fn check_hits(gpu_scene: &GpuScene, rays: &[TraceRay], hits: &[TraceHit], accel: Accel) {
-    let (mut hit_count, mut mesh_hits, mut mismatches) = (0, 0, 0);
+    let (mut hit_count, mut mesh_hits, mut ties) = (0, 0, 0);
     for (ray, gpu) in rays.iter().zip(hits) {
-        let cpu = gpu_scene.intersect(
-            &Ray {
-                origin: ray.origin.into(),
-                dir: ray.dir.into(),
-            },
-            ray.t_max,
-        );
+        let cpu = gpu_scene.intersect(&ray_of(ray), ray.t_max);
         assert_eq!(
             gpu.blocked == 1,
             cpu.is_some(),
@@ -208,8 +202,15 @@ fn check_hits(gpu_scene: &GpuScene, rays: &[TraceRay], hits: &[TraceHit], accel:
                     "{accel:?}: t: GPU {gpu:?}, CPU {cpu:?}"
                 );
                 if (gpu.object, gpu.primitive) != (cpu.object, cpu.primitive) {
-                    // Only a ray through a shared edge may pick either neighbour.
-                    mismatches += 1;
+                    // A tie: a ray through a shared edge, or onto two coincident surfaces
+                    // (the vase's base on the floor), may report either primitive, but the
+                    // GPU's must lie at the same distance.
+                    let t = distance_to(gpu_scene, &ray_of(ray), gpu.object, gpu.primitive);
+                    assert!(
+                        (t - cpu.t).abs() <= 1e-5 * cpu.t.max(1.0),
+                        "{accel:?}: GPU {gpu:?} (at {t}) where the CPU twin hits {cpu:?}"
+                    );
+                    ties += 1;
                 }
                 mesh_hits += usize::from(gpu_scene.objects[gpu.object as usize].kind == KIND_MESH);
             }
@@ -220,9 +221,28 @@ fn check_hits(gpu_scene: &GpuScene, rays: &[TraceRay], hits: &[TraceHit], accel:
         "{accel:?}: {hit_count} hits, {mesh_hits} on the vase"
     );
     assert!(
-        mismatches <= 5,
-        "{accel:?}: {mismatches} rays hit a different primitive on the GPU"
+        ties <= hit_count / 500,
+        "{accel:?}: {ties} of {hit_count} hits are ties; too many to be chance"
     );
+}
+
+fn ray_of(ray: &TraceRay) -> Ray {
+    Ray {
+        origin: ray.origin.into(),
+        dir: ray.dir.into(),
+    }
+}
+
+/// Where `ray` meets primitive `primitive` of object `object` (a hit's pair), or MISS.
+fn distance_to(gpu_scene: &GpuScene, ray: &Ray, object: u32, primitive: u32) -> f32 {
+    if gpu_scene.objects[object as usize].kind == KIND_MESH {
+        let [v0, v1, v2] = gpu_scene.triangle(primitive);
+        intersect_triangle(v0, v1, v2, ray, MISS).0
+    } else {
+        let mut hit = Hit::none(MISS);
+        gpu_scene.intersect_shape(object, ray, &mut hit);
+        hit.t
+    }
 }
 
 /// Rays that fill the traversal stack: a row of 200 spheres along -z whose boxes every ray
@@ -278,10 +298,7 @@ fn traversal_stack_bound_holds_the_deepest_walk() {
         let hits = trace_on_gpu(&gpu_scene, &rays, Accel::Bvh, stack_divisor);
         hits.iter()
             .enumerate()
-            .filter(|(j, hit)| {
-                hit.object != u32::MAX
-                    && gpu_scene.objects[hit.object as usize].id as usize == SPHERES + j
-            })
+            .filter(|(j, hit)| hit.object != u32::MAX && hit.object as usize == SPHERES + j)
             .count()
     };
     assert_eq!(
