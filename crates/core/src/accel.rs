@@ -276,34 +276,19 @@ impl GpuScene {
     /// them (so that a leaf's triangles lie side by side for shading too), and the
     /// primitives in leaf order.
     fn lay_out_meshes(&mut self, scene: &Scene, leaf_order: &[PrimitiveRef]) {
-        let mut by_mesh: Vec<Vec<u32>> = vec![Vec::new(); scene.objects.len()];
-        for p in leaf_order.iter().filter(|p| p.triangle != NO_TRIANGLE) {
-            by_mesh[p.object as usize].push(p.triangle);
-        }
-        // Per object, where each of its triangles lands in the vertex buffer.
-        let mut slot: Vec<Vec<u32>> = vec![Vec::new(); scene.objects.len()];
+        // Per object, the vertex-buffer triangle its next leaf-order triangle takes.
+        let mut next = vec![0u32; scene.objects.len()];
+        let mut total = 0u32;
         for (i, object) in scene.objects.iter().enumerate() {
-            let Shape::Mesh(mesh) = &object.shape else {
-                continue;
-            };
-            let first = (self.vertices.len() / 3) as u32;
-            self.objects[i].first_triangle = first;
-            self.objects[i].triangle_count = by_mesh[i].len() as u32;
-            slot[i] = vec![0; mesh.indices.len()];
-            for (k, &t) in by_mesh[i].iter().enumerate() {
-                slot[i][t as usize] = first + k as u32;
-                for v in mesh.indices[t as usize] {
-                    let v = v as usize;
-                    let uv = mesh.uvs.get(v).copied().unwrap_or_default();
-                    self.vertices.push(GpuVertex {
-                        position: mesh.positions[v].to_array(),
-                        u: uv.x,
-                        normal: mesh.normals.get(v).copied().unwrap_or_default().to_array(),
-                        v: uv.y,
-                    });
-                }
+            if let Shape::Mesh(mesh) = &object.shape {
+                let count = mesh.indices.len() as u32;
+                self.objects[i].first_triangle = total;
+                self.objects[i].triangle_count = count;
+                next[i] = total;
+                total += count;
             }
         }
+        self.vertices = vec![GpuVertex::zeroed(); 3 * total as usize];
         self.primitives = leaf_order
             .iter()
             .map(|p| {
@@ -312,14 +297,27 @@ impl GpuScene {
                     triangle: NO_TRIANGLE,
                     ..GpuPrimitive::zeroed()
                 };
-                if p.triangle != NO_TRIANGLE {
-                    let triangle = slot[p.object as usize][p.triangle as usize];
-                    let [v0, v1, v2] = self.triangle(triangle);
-                    primitive.v0 = v0.to_array();
-                    primitive.e1 = (v1 - v0).to_array();
-                    primitive.e2 = (v2 - v0).to_array();
-                    primitive.triangle = triangle;
+                let Shape::Mesh(mesh) = &scene.objects[p.object as usize].shape else {
+                    return primitive;
+                };
+                let triangle = next[p.object as usize];
+                next[p.object as usize] += 1;
+                let corners = mesh.indices[p.triangle as usize];
+                for (k, v) in corners.into_iter().enumerate() {
+                    let v = v as usize;
+                    let uv = mesh.uvs.get(v).copied().unwrap_or_default();
+                    self.vertices[3 * triangle as usize + k] = GpuVertex {
+                        position: mesh.positions[v].to_array(),
+                        u: uv.x,
+                        normal: mesh.normals.get(v).copied().unwrap_or_default().to_array(),
+                        v: uv.y,
+                    };
                 }
+                let [v0, v1, v2] = corners.map(|v| mesh.positions[v as usize]);
+                primitive.v0 = v0.to_array();
+                primitive.e1 = (v1 - v0).to_array();
+                primitive.e2 = (v2 - v0).to_array();
+                primitive.triangle = triangle;
                 primitive
             })
             .collect();
