@@ -3,10 +3,11 @@
 //! twin itself is checked against brute force in `crates/core/tests/bvh.rs`.
 
 use crate::common::context;
-use glam::Vec3;
-use pathlight_core::gpu::KIND_MESH;
+use glam::{Vec2, Vec3};
+use pathlight_core::gpu::{KIND_MESH, NO_TRIANGLE, SHAPE_LEAF};
+use pathlight_core::scene::TriangleMesh;
 use pathlight_core::trace::{Hit, MISS, Ray, intersect_triangle};
-use pathlight_core::{GpuScene, default_scene};
+use pathlight_core::{GpuScene, Object, Shape, WideBvh, default_scene};
 use pathlight_render::Accel;
 use pathlight_render::scene_buffers::{SceneBuffers, create_compute_pipeline, storage_entry};
 use pathlight_render::shaders;
@@ -136,16 +137,12 @@ fn trace_on_gpu(
     bytemuck::cast_slice(&view).to_vec()
 }
 
-/// Every acceleration scheme finds what the CPU twin finds.
-#[test]
-fn wgsl_traversal_matches_cpu_twin() {
-    let scene = default_scene::load().unwrap();
-    let gpu_scene = GpuScene::build(&scene);
-    let mut rng = StdRng::seed_from_u64(5);
-    let rays: Vec<TraceRay> = (0..20_000)
+/// Rays from inside the room and in front of it, directions uniform on the sphere, every
+/// tenth with a short t_max.
+fn room_rays(seed: u64, count: usize) -> Vec<TraceRay> {
+    let mut rng = StdRng::seed_from_u64(seed);
+    (0..count)
         .map(|i| {
-            // Origins inside the room and in front of it; directions uniform on the sphere;
-            // every tenth ray with a short t_max.
             let origin = Vec3::new(
                 rng.random_range(-1.9..1.9),
                 rng.random_range(0.01..2.3),
@@ -169,7 +166,14 @@ fn wgsl_traversal_matches_cpu_twin() {
                 pad: 0.0,
             }
         })
-        .collect();
+        .collect()
+}
+
+/// Every acceleration scheme finds what the CPU twin finds.
+#[test]
+fn wgsl_traversal_matches_cpu_twin() {
+    let gpu_scene = GpuScene::build(&default_scene::load().unwrap());
+    let rays = room_rays(5, 20_000);
     for accel in Accel::ALL {
         check_hits(
             &gpu_scene,
@@ -178,6 +182,77 @@ fn wgsl_traversal_matches_cpu_twin() {
             accel,
         );
     }
+}
+
+/// Leaves that hold shapes and triangles together (tested at once on the GPU, like leaves of
+/// shapes alone) find what the CPU twin finds: the default scene with small spheres strewn
+/// among the triangles of a cloud of small ones.
+#[test]
+fn wgsl_traversal_matches_cpu_twin_in_mixed_leaves() {
+    let mut scene = default_scene::load().unwrap();
+    let mut rng = StdRng::seed_from_u64(9);
+    let mut point = |rng: &mut StdRng| {
+        Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(0.3..1.5),
+            rng.random_range(-1.0..0.5),
+        )
+    };
+    let mut cloud = TriangleMesh::default();
+    for t in 0..400u32 {
+        let p = point(&mut rng);
+        for _ in 0..3 {
+            let corner = p + 0.05 * (point(&mut rng) - Vec3::new(0.0, 0.9, -0.25));
+            cloud.positions.push(corner);
+            cloud.normals.push(Vec3::Y);
+            cloud.uvs.push(Vec2::ZERO);
+        }
+        cloud.indices.push([3 * t, 3 * t + 1, 3 * t + 2]);
+    }
+    let material = scene.objects[0].material;
+    for i in 0..100 {
+        scene.objects.push(Object {
+            name: format!("bead {i}"),
+            material,
+            shape: Shape::Sphere {
+                center: point(&mut rng),
+                radius: 0.02,
+                texture_rotation: 0.0,
+            },
+        });
+    }
+    scene.objects.push(Object {
+        name: "cloud".into(),
+        material,
+        shape: Shape::Mesh(cloud),
+    });
+    let gpu_scene = GpuScene::build(&scene);
+    let mixed = WideBvh::build(&gpu_scene)
+        .gpu_nodes()
+        .iter()
+        .flat_map(|n| (0..4).map(|lane| (n.first[lane], n.count[lane])))
+        .filter(|&(first, count)| {
+            let count = count & !SHAPE_LEAF;
+            count != 0
+                && gpu_scene.primitives[first as usize..(first + count) as usize]
+                    .iter()
+                    .any(|p| p.triangle != NO_TRIANGLE)
+                && gpu_scene.primitives[first as usize..(first + count) as usize]
+                    .iter()
+                    .any(|p| p.triangle == NO_TRIANGLE)
+        })
+        .count();
+    assert!(
+        mixed >= 5,
+        "only {mixed} leaves hold both kinds; the test would prove little"
+    );
+    let rays = room_rays(6, 20_000);
+    check_hits(
+        &gpu_scene,
+        &rays,
+        &trace_on_gpu(&gpu_scene, &rays, Accel::Bvh, 1),
+        Accel::Bvh,
+    );
 }
 
 fn check_hits(gpu_scene: &GpuScene, rays: &[TraceRay], hits: &[TraceHit], accel: Accel) {
