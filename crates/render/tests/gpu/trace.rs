@@ -191,7 +191,7 @@ fn wgsl_traversal_matches_cpu_twin() {
 fn wgsl_traversal_matches_cpu_twin_in_mixed_leaves() {
     let mut scene = default_scene::load().unwrap();
     let mut rng = StdRng::seed_from_u64(9);
-    let mut point = |rng: &mut StdRng| {
+    let point = |rng: &mut StdRng| {
         Vec3::new(
             rng.random_range(-1.0..1.0),
             rng.random_range(0.3..1.5),
