@@ -154,12 +154,14 @@ impl WideBvh {
     /// Most entries the traversal stack of WGSL `trace_scene` can hold at once. At each node
     /// the walk tests the entered leaves that hold shapes at once and pushes the other
     /// entered children but the nearest, and the stack holds only the pending entries of
-    /// the current node and its ancestors. The integrator's stack is sized from it.
+    /// the current node and its ancestors (an entry is popped before its node is visited).
+    /// The integrator's stack is sized from it.
     pub fn stack_bound(&self) -> u32 {
         if self.nodes.is_empty() {
             return 1;
         }
-        self.path_pushes(0) + 1
+        // At least one entry: WGSL has no empty arrays.
+        self.path_pushes(0).max(1)
     }
 
     /// Most entries pushed along one path down from `node`.
