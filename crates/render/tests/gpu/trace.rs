@@ -7,7 +7,7 @@ use glam::{Vec2, Vec3};
 use pathlight_core::gpu::{KIND_MESH, NO_TRIANGLE, SHAPE_LEAF};
 use pathlight_core::scene::TriangleMesh;
 use pathlight_core::trace::{Hit, MISS, Ray, intersect_triangle};
-use pathlight_core::{GpuScene, Object, Shape, WideBvh, default_scene};
+use pathlight_core::{GpuScene, Object, Shape, Tracer, WideBvh, default_scene};
 use pathlight_render::Accel;
 use pathlight_render::scene_buffers::{SceneBuffers, create_compute_pipeline, storage_entry};
 use pathlight_render::shaders;
@@ -253,6 +253,48 @@ fn wgsl_traversal_matches_cpu_twin_in_mixed_leaves() {
         &trace_on_gpu(&gpu_scene, &rays, Accel::Bvh, 1),
         Accel::Bvh,
     );
+}
+
+/// A scene whose only object is a mesh without triangles has no primitive: nothing is hit,
+/// on the GPU (whose tree is then one node no ray enters) and on the CPU.
+#[test]
+fn a_scene_without_primitives_hits_nothing() {
+    let mut scene = default_scene::load().unwrap();
+    let material = scene.objects[0].material;
+    scene.objects = vec![Object {
+        name: "empty".into(),
+        material,
+        shape: Shape::Mesh(TriangleMesh::default()),
+    }];
+    let gpu_scene = GpuScene::build(&scene);
+    assert!(gpu_scene.primitives.is_empty());
+    let wide = WideBvh::build(&gpu_scene);
+    // The GPU's placeholder: four unused children (inverted boxes), so that no ray enters
+    // it and loops (an empty box at the origin would be entered by rays through the origin).
+    let nodes = wide.gpu_nodes();
+    assert_eq!(nodes.len(), 1);
+    let n = nodes[0];
+    for lane in 0..4 {
+        assert!(
+            n.lo_x[lane] > n.hi_x[lane]
+                && n.lo_y[lane] > n.hi_y[lane]
+                && n.lo_z[lane] > n.hi_z[lane],
+            "placeholder child {lane} can be entered"
+        );
+    }
+    let rays = room_rays(7, 256);
+    for accel in Accel::ALL {
+        let hits = trace_on_gpu(&gpu_scene, &rays, accel, 1);
+        assert!(
+            hits.iter().all(|h| h.object == u32::MAX && h.blocked == 0),
+            "{accel:?}: a hit in an empty scene"
+        );
+    }
+    let mut tracer = Tracer::new(&gpu_scene, &wide);
+    for ray in &rays {
+        assert_eq!(tracer.intersect(&ray_of(ray), ray.t_max), None);
+        assert_eq!(gpu_scene.intersect(&ray_of(ray), ray.t_max), None);
+    }
 }
 
 fn check_hits(gpu_scene: &GpuScene, rays: &[TraceRay], hits: &[TraceHit], accel: Accel) {
