@@ -61,6 +61,15 @@ fn intersect_shape(i: u32, o: Object, ray: Ray, hit: ptr<function, Hit>) {
     }
 }
 
+// Hit on triangle `triangle` (its corner and edges) of mesh object `object`, if nearer than
+// `hit`.
+fn hit_triangle(object: u32, triangle: u32, v0: vec3f, e1: vec3f, e2: vec3f, ray: Ray, hit: ptr<function, Hit>) {
+    let r = intersect_triangle_edges(v0, e1, e2, ray, (*hit).t);
+    if r.x < (*hit).t {
+        *hit = Hit(r.x, object, triangle, r.y, r.z);
+    }
+}
+
 // Nearest hit on primitive `i`, a shape or a triangle, updating `hit`.
 fn intersect_primitive(i: u32, ray: Ray, hit: ptr<function, Hit>) {
     let p = primitives[i];
@@ -68,20 +77,14 @@ fn intersect_primitive(i: u32, ray: Ray, hit: ptr<function, Hit>) {
         intersect_shape(p.object, objects[p.object], ray, hit);
         return;
     }
-    let r = intersect_triangle_edges(p.v0, p.e1, p.e2, ray, (*hit).t);
-    if r.x < (*hit).t {
-        *hit = Hit(r.x, p.object, p.triangle, r.y, r.z);
-    }
+    hit_triangle(p.object, p.triangle, p.v0, p.e1, p.e2, ray, hit);
 }
 
 // Nearest hit among primitives `first .. first + count`, all triangles.
 fn intersect_triangles(first: u32, count: u32, ray: Ray, hit: ptr<function, Hit>) {
     for (var i = first; i < first + count; i++) {
         let p = primitives[i];
-        let r = intersect_triangle_edges(p.v0, p.e1, p.e2, ray, (*hit).t);
-        if r.x < (*hit).t {
-            *hit = Hit(r.x, p.object, p.triangle, r.y, r.z);
-        }
+        hit_triangle(p.object, p.triangle, p.v0, p.e1, p.e2, ray, hit);
     }
 }
 
@@ -91,10 +94,7 @@ fn intersect_mesh(i: u32, o: Object, ray: Ray, hit: ptr<function, Hit>) {
         let v0 = vertices[3u * tri].position;
         let e1 = vertices[3u * tri + 1u].position - v0;
         let e2 = vertices[3u * tri + 2u].position - v0;
-        let r = intersect_triangle_edges(v0, e1, e2, ray, (*hit).t);
-        if r.x < (*hit).t {
-            *hit = Hit(r.x, i, tri, r.y, r.z);
-        }
+        hit_triangle(i, tri, v0, e1, e2, ray, hit);
     }
 }
 
