@@ -248,7 +248,7 @@ impl GpuScene {
                 .iter()
                 .map(|&p| refs[p as usize])
                 .collect();
-            out.lay_out_meshes(scene, &leaf_order);
+            out.lay_out_primitives(scene, &leaf_order);
         }
         out.build_lights();
         if out.objects.is_empty() {
@@ -275,7 +275,7 @@ impl GpuScene {
     /// Fills the vertex buffer, each mesh's triangles together in the order the leaves hold
     /// them (so that a leaf's triangles lie side by side for shading too), and the
     /// primitives in leaf order.
-    fn lay_out_meshes(&mut self, scene: &Scene, leaf_order: &[PrimitiveRef]) {
+    fn lay_out_primitives(&mut self, scene: &Scene, leaf_order: &[PrimitiveRef]) {
         // Per object, the vertex-buffer triangle its next leaf-order triangle takes.
         let mut next = vec![0u32; scene.objects.len()];
         let mut total = 0u32;
