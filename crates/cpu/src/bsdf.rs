@@ -15,7 +15,7 @@
 
 use std::f32::consts::{FRAC_1_PI, PI};
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3A};
 use pathlight_core::gpu::GpuMaterial;
 
 use crate::sampling::{Frame, sample_cosine_hemisphere, sin_cos_turns};
@@ -28,7 +28,7 @@ pub const ALPHA_MIN: f32 = 1e-3;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BsdfEval {
     /// `f * |cos(wi, ns)|`.
-    pub f: Vec3,
+    pub f: Vec3A,
     /// Density of `sample` producing `wi` (solid angle).
     pub pdf: f32,
 }
@@ -37,9 +37,9 @@ pub struct BsdfEval {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BsdfSample {
     /// Incident direction (unit, pointing away from the surface).
-    pub wi: Vec3,
+    pub wi: Vec3A,
     /// `f * |cos| / pdf` (for a delta lobe: its reflectance or transmittance).
-    pub weight: Vec3,
+    pub weight: Vec3A,
     /// Solid-angle density of the whole mixture at `wi`; 0 for a delta lobe.
     pub pdf: f32,
     /// Sampled from a delta lobe (no next-event estimation or MIS applies).
@@ -52,8 +52,8 @@ pub struct BsdfSample {
 }
 
 const INVALID: BsdfSample = BsdfSample {
-    wi: Vec3::ZERO,
-    weight: Vec3::ZERO,
+    wi: Vec3A::ZERO,
+    weight: Vec3A::ZERO,
     pdf: 0.0,
     delta: false,
     eta: 1.0,
@@ -76,42 +76,42 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
 /// Unpolarised conductor Fresnel reflectance for IOR eta + i k (Mitsuba 3's
 /// `fresnel_conductor`). Twin of WGSL `fresnel_conductor`.
 #[inline(always)]
-pub fn fresnel_conductor(cos_i: f32, eta: Vec3, k: Vec3) -> Vec3 {
+pub fn fresnel_conductor(cos_i: f32, eta: Vec3A, k: Vec3A) -> Vec3A {
     let cos2 = cos_i * cos_i;
     let sin2 = 1.0 - cos2;
     let eta2 = eta * eta;
     let k2 = k * k;
     let t0 = eta2 - k2 - sin2;
-    let a2pb2 = (t0 * t0 + 4.0 * eta2 * k2).max(Vec3::ZERO).map(f32::sqrt);
-    let a = (0.5 * (a2pb2 + t0)).max(Vec3::ZERO).map(f32::sqrt);
+    let a2pb2 = (t0 * t0 + 4.0 * eta2 * k2).max(Vec3A::ZERO).map(f32::sqrt);
+    let a = (0.5 * (a2pb2 + t0)).max(Vec3A::ZERO).map(f32::sqrt);
     let t1 = a2pb2 + cos2;
     let t2 = 2.0 * cos_i * a;
-    let rs = (t1 - t2) / (t1 + t2).max(Vec3::splat(1e-20));
+    let rs = (t1 - t2) / (t1 + t2).max(Vec3A::splat(1e-20));
     let t3 = cos2 * a2pb2 + sin2 * sin2;
     let t4 = t2 * sin2;
-    let rp = rs * (t3 - t4) / (t3 + t4).max(Vec3::splat(1e-20));
+    let rp = rs * (t3 - t4) / (t3 + t4).max(Vec3A::splat(1e-20));
     0.5 * (rp + rs)
 }
 
 /// Reflectance of the specular lobe at `cos_i`. Twin of WGSL `specular_reflectance`.
 #[inline(always)]
-fn specular_reflectance(m: &GpuMaterial, color: Vec3, cos_i: f32) -> Vec3 {
+fn specular_reflectance(m: &GpuMaterial, color: Vec3A, cos_i: f32) -> Vec3A {
     if m.conductor != 0 {
-        return fresnel_conductor(cos_i, Vec3::from(m.eta), Vec3::from(m.k));
+        return fresnel_conductor(cos_i, Vec3A::from(m.eta), Vec3A::from(m.k));
     }
-    let f0 = Vec3::ONE.lerp(color, m.specular_tint);
+    let f0 = Vec3A::ONE.lerp(color, m.specular_tint);
     f0 + (1.0 - f0) * (1.0 - cos_i.clamp(0.0, 1.0)).powi(5)
 }
 
 /// GGX normal distribution, local `m`. Twin of WGSL `ggx_d`.
-pub fn ggx_d(m: Vec3, alpha: f32) -> f32 {
+pub fn ggx_d(m: Vec3A, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     let t = (m.x * m.x + m.y * m.y) / a2 + m.z * m.z;
     1.0 / (PI * a2 * t * t)
 }
 
 /// Smith masking of one direction (either hemisphere). Twin of WGSL `ggx_g1`.
-pub fn ggx_g1(w: Vec3, alpha: f32) -> f32 {
+pub fn ggx_g1(w: Vec3A, alpha: f32) -> f32 {
     let z2 = w.z * w.z;
     if z2 <= 0.0 {
         return 0.0;
@@ -123,14 +123,14 @@ pub fn ggx_g1(w: Vec3, alpha: f32) -> f32 {
 /// A GGX normal visible from `wo` (flipped into the upper hemisphere), Heitz 2018.
 /// Twin of WGSL `ggx_sample_visible`.
 #[inline(always)]
-pub fn ggx_sample_visible(wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
+pub fn ggx_sample_visible(wo: Vec3A, alpha: f32, u: Vec2) -> Vec3A {
     let w = if wo.z < 0.0 { -wo } else { wo };
-    let vh = Vec3::new(alpha * w.x, alpha * w.y, w.z).normalize();
+    let vh = Vec3A::new(alpha * w.x, alpha * w.y, w.z).normalize();
     let len2 = vh.x * vh.x + vh.y * vh.y;
     let t1 = if len2 > 0.0 {
-        Vec3::new(-vh.y, vh.x, 0.0) / len2.sqrt()
+        Vec3A::new(-vh.y, vh.x, 0.0) / len2.sqrt()
     } else {
-        Vec3::X
+        Vec3A::X
     };
     let t2 = vh.cross(t1);
     let r = u.x.sqrt();
@@ -139,17 +139,17 @@ pub fn ggx_sample_visible(wo: Vec3, alpha: f32, u: Vec2) -> Vec3 {
     let s = 0.5 * (1.0 + vh.z);
     let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sin;
     let nh = p1 * t1 + p2 * t2 + (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt() * vh;
-    Vec3::new(alpha * nh.x, alpha * nh.y, nh.z.max(1e-7)).normalize()
+    Vec3A::new(alpha * nh.x, alpha * nh.y, nh.z.max(1e-7)).normalize()
 }
 
 /// Density of `ggx_sample_visible` producing `m`. Twin of WGSL `ggx_pdf_visible`.
-fn ggx_pdf_visible(wo: Vec3, m: Vec3, alpha: f32) -> f32 {
+fn ggx_pdf_visible(wo: Vec3A, m: Vec3A, alpha: f32) -> f32 {
     ggx_g1(wo, alpha) * wo.dot(m).abs() * ggx_d(m, alpha) / wo.z.abs()
 }
 
 /// Lobe weights (diffuse, specular, transmission). Twin of WGSL `lobe_weights`.
-fn lobe_weights(m: &GpuMaterial) -> Vec3 {
-    Vec3::new(
+fn lobe_weights(m: &GpuMaterial) -> Vec3A {
+    Vec3A::new(
         (1.0 - m.specular_rate - m.refract_rate).max(0.0),
         m.specular_rate,
         m.refract_rate,
@@ -168,14 +168,14 @@ fn fresnel_dielectric_local(cos_om: f32, ior: f32) -> f32 {
 
 /// The continuous part of the BSDF. Twin of WGSL `eval_bsdf`.
 #[inline(always)]
-pub fn eval_bsdf(m: &GpuMaterial, color: Vec3, s: &Surface, wo: Vec3, wi: Vec3) -> BsdfEval {
+pub fn eval_bsdf(m: &GpuMaterial, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfEval {
     let weights = lobe_weights(m);
     let front = wo.dot(s.ng) >= 0.0;
     let sign = if front { 1.0 } else { -1.0 };
     let ng = s.ng * sign;
     let n = s.ns * sign;
     let mut out = BsdfEval {
-        f: Vec3::ZERO,
+        f: Vec3A::ZERO,
         pdf: 0.0,
     };
     let same_side = wi.dot(ng) > 0.0;
@@ -212,14 +212,14 @@ pub fn eval_bsdf(m: &GpuMaterial, color: Vec3, s: &Surface, wo: Vec3, wi: Vec3) 
 #[inline(always)]
 fn eval_rough_dielectric(
     m: &GpuMaterial,
-    color: Vec3,
+    color: Vec3A,
     s: &Surface,
-    wo: Vec3,
-    wi: Vec3,
+    wo: Vec3A,
+    wi: Vec3A,
     alpha: f32,
 ) -> BsdfEval {
     let none = BsdfEval {
-        f: Vec3::ZERO,
+        f: Vec3A::ZERO,
         pdf: 0.0,
     };
     let frame = Frame::around(s.ns);
@@ -255,12 +255,12 @@ fn eval_rough_dielectric(
     let pdf_h = ggx_pdf_visible(wo_l, h, alpha);
     if reflect {
         BsdfEval {
-            f: Vec3::splat(d * g * fr / (4.0 * cos_o.abs())),
+            f: Vec3A::splat(d * g * fr / (4.0 * cos_o.abs())),
             pdf: pdf_h / (4.0 * wo_l.dot(h).abs()) * fr,
         }
     } else {
         let denom = (wi_l.dot(h) + wo_l.dot(h) / etap).powi(2);
-        let tint = Vec3::ONE.lerp(color, m.refract_tint);
+        let tint = Vec3A::ONE.lerp(color, m.refract_tint);
         let ft = (1.0 - fr) * d * g * (wi_l.dot(h) * wo_l.dot(h)).abs()
             / (cos_o.abs() * denom)
             / (etap * etap);
@@ -273,7 +273,7 @@ fn eval_rough_dielectric(
 
 /// `f / pdf` of the whole mixture at a sampled non-delta `wi`. Twin of WGSL `mixture_sample`.
 #[inline(always)]
-fn mixture_sample(m: &GpuMaterial, color: Vec3, s: &Surface, wo: Vec3, wi: Vec3) -> BsdfSample {
+fn mixture_sample(m: &GpuMaterial, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfSample {
     let e = eval_bsdf(m, color, s, wo, wi);
     if e.pdf <= 0.0 || !e.pdf.is_finite() {
         return INVALID;
@@ -300,9 +300,9 @@ fn mixture_sample(m: &GpuMaterial, color: Vec3, s: &Surface, wo: Vec3, wi: Vec3)
 #[inline(always)]
 pub fn sample_bsdf(
     m: &GpuMaterial,
-    color: Vec3,
+    color: Vec3A,
     s: &Surface,
-    wo: Vec3,
+    wo: Vec3A,
     u_lobe: f32,
     u_fresnel: f32,
     u: Vec2,
@@ -387,9 +387,9 @@ pub fn sample_bsdf(
 #[inline(always)]
 fn sample_smooth_dielectric(
     m: &GpuMaterial,
-    color: Vec3,
+    color: Vec3A,
     s: &Surface,
-    wo: Vec3,
+    wo: Vec3A,
     u_fresnel: f32,
 ) -> BsdfSample {
     let front = wo.dot(s.ng) >= 0.0;
@@ -407,7 +407,7 @@ fn sample_smooth_dielectric(
         let valid = wi.dot(ng) > 0.0;
         return BsdfSample {
             wi,
-            weight: Vec3::ONE,
+            weight: Vec3A::ONE,
             pdf: 0.0,
             delta: true,
             eta: 1.0,
@@ -417,7 +417,7 @@ fn sample_smooth_dielectric(
     let sin2_t = (1.0 - cos_o * cos_o) / (eta * eta);
     let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
     let wi = -wo / eta + (cos_o / eta - cos_t) * n;
-    let weight = Vec3::ONE.lerp(color, m.refract_tint) / (eta * eta);
+    let weight = Vec3A::ONE.lerp(color, m.refract_tint) / (eta * eta);
     BsdfSample {
         wi,
         weight,

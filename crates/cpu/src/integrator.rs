@@ -1,7 +1,7 @@
 //! Unidirectional path tracing with next-event estimation and MIS. Twin of
 //! `integrator.wgsl` (same loop, same order of sample dimensions).
 
-use glam::Vec3;
+use glam::Vec3A;
 use pathlight_core::Tracer;
 use pathlight_core::gpu::{GpuFrameParams, NO_LIGHT};
 use pathlight_core::trace::{Hit, Ray};
@@ -21,9 +21,18 @@ pub const T_MAX: f32 = 1.0e30;
 /// Start of a ray leaving `p` on the side of `ng` that `dir` points to. Twin of WGSL
 /// `offset_origin`.
 #[inline(always)]
-fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
+fn offset_origin(p: Vec3A, ng: Vec3A, dir: Vec3A) -> Vec3A {
     let eps = 1e-4 * (1.0 + p.abs().max_element());
     p + if dir.dot(ng) > 0.0 { ng } else { -ng } * eps
+}
+
+/// The ray from `origin` along `dir`.
+#[inline(always)]
+fn ray_from(origin: Vec3A, dir: Vec3A) -> Ray {
+    Ray {
+        origin: origin.into(),
+        dir: dir.into(),
+    }
 }
 
 /// Camera ray through a jittered point of pixel (x, y). Twin of WGSL `camera_ray`.
@@ -32,12 +41,12 @@ fn camera_ray(params: &GpuFrameParams, x: u32, y: u32, sampler: &mut Sampler) ->
     let jitter = sampler.next_2d();
     let ndc_x = 2.0 * (x as f32 + jitter.x) / params.width as f32 - 1.0;
     let ndc_y = 1.0 - 2.0 * (y as f32 + jitter.y) / params.height as f32;
-    let dir = Vec3::from(params.camera_forward)
-        + ndc_x * Vec3::from(params.camera_right)
-        + ndc_y * Vec3::from(params.camera_up);
+    let dir = Vec3A::from(params.camera_forward)
+        + ndc_x * Vec3A::from(params.camera_right)
+        + ndc_y * Vec3A::from(params.camera_up);
     Ray {
         origin: params.camera_position.into(),
-        dir: dir.normalize(),
+        dir: dir.normalize().into(),
     }
 }
 
@@ -46,25 +55,24 @@ fn camera_ray(params: &GpuFrameParams, x: u32, y: u32, sampler: &mut Sampler) ->
 /// light point itself, stopping just short of it, so the light never shadows itself. Twin of
 /// WGSL `occluded`.
 #[inline(always)]
-fn shadow_ray(p: Vec3, ng: Vec3, ls: &LightSample) -> (Ray, f32) {
+fn shadow_ray(p: Vec3A, ng: Vec3A, ls: &LightSample) -> (Ray, f32) {
     let origin = offset_origin(p, ng, ls.wi);
     if !ls.finite {
-        return (Ray { origin, dir: ls.wi }, T_MAX);
+        return (ray_from(origin, ls.wi), T_MAX);
     }
     let to_light = ls.point - origin;
     let distance = to_light.length();
-    let ray = Ray {
-        origin,
-        dir: to_light / distance,
-    };
-    (ray, distance * (1.0 - 1e-4))
+    (
+        ray_from(origin, to_light / distance),
+        distance * (1.0 - 1e-4),
+    )
 }
 
 /// What one camera path brought back.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PathSample {
     /// Radiance along the path.
-    pub radiance: Vec3,
+    pub radiance: Vec3A,
     /// Rays traced for it (camera, extension and shadow rays).
     pub rays: u32,
 }
@@ -77,7 +85,7 @@ pub struct ShadowTest {
     /// The end of its interval.
     pub t_max: f32,
     /// Radiance added to the path when nothing blocks the ray.
-    pub radiance: Vec3,
+    pub radiance: Vec3A,
 }
 
 /// One camera path in progress, between its ray queries: [`Path::ray`] is to be traced and
@@ -92,15 +100,15 @@ pub struct Path {
     pub sample: PathSample,
     sampler: Sampler,
     depth: u32,
-    throughput: Vec3,
+    throughput: Vec3A,
     /// Density of the BSDF sample that produced `ray`, and whether it came from a delta
     /// lobe (camera rays count as delta: emitters they see get full weight).
     prev_pdf: f32,
     prev_delta: bool,
-    prev_position: Vec3,
+    prev_position: Vec3A,
     /// Normal (on the side of wo) at the vertex that produced `ray`: environment sampling
     /// there was cosine-weighted about it.
-    prev_normal: Vec3,
+    prev_normal: Vec3A,
     /// Product of the relative IORs crossed: throughput * eta_scale^2 is the throughput
     /// without the 1/eta^2 radiance scaling, which Russian roulette should see.
     eta_scale: f32,
@@ -115,16 +123,16 @@ impl Path {
             ray,
             alive: params.max_depth > 0,
             sample: PathSample {
-                radiance: Vec3::ZERO,
+                radiance: Vec3A::ZERO,
                 rays: 0,
             },
             sampler,
             depth: 0,
-            throughput: Vec3::ONE,
+            throughput: Vec3A::ONE,
             prev_pdf: 0.0,
             prev_delta: true,
-            prev_position: ray.origin,
-            prev_normal: Vec3::ZERO,
+            prev_position: ray.origin.into(),
+            prev_normal: Vec3A::ZERO,
             eta_scale: 1.0,
         }
     }
@@ -146,16 +154,19 @@ impl Path {
             let w = if self.prev_delta {
                 1.0
             } else {
-                power_heuristic(self.prev_pdf, env_pdf(params, self.prev_normal, ray.dir))
+                power_heuristic(
+                    self.prev_pdf,
+                    env_pdf(params, self.prev_normal, ray.dir.into()),
+                )
             };
-            self.sample.radiance += self.throughput * Vec3::from(params.environment) * w;
+            self.sample.radiance += self.throughput * Vec3A::from(params.environment) * w;
             self.alive = false;
             return None;
         };
         let s = surface_at(scene, &hit, &ray);
         let material = &scene.gpu.materials[s.material as usize];
-        let wo = -ray.dir;
-        let emission = Vec3::from(material.emission);
+        let wo = -Vec3A::from(ray.dir);
+        let emission = Vec3A::from(material.emission);
         if wo.dot(s.ng) > 0.0 && emission.max_element() > 0.0 {
             let object = &scene.gpu.objects[hit.object as usize];
             let w = if self.prev_delta || object.light == NO_LIGHT {
@@ -229,16 +240,13 @@ impl Path {
             }
             self.throughput /= q;
         }
-        self.ray = Ray {
-            origin: offset_origin(s.position, s.ng, bs.wi),
-            dir: bs.wi,
-        };
+        self.ray = ray_from(offset_origin(s.position, s.ng, bs.wi), bs.wi);
         shadow
     }
 
     /// Adds the radiance of a [`ShadowTest`] whose ray nothing blocked.
     #[inline(always)]
-    pub fn add_unblocked(&mut self, radiance: Vec3) {
+    pub fn add_unblocked(&mut self, radiance: Vec3A) {
         self.sample.radiance += radiance;
     }
 }
@@ -269,10 +277,10 @@ pub fn trace_path(
 /// A sample as it is accumulated: non-finite samples count as zero, channels are clamped to
 /// [0, SAMPLE_MAX]. Twin of the checks in WGSL `render` and `add_sample`.
 #[inline(always)]
-pub fn accumulated_value(radiance: Vec3) -> Vec3 {
+pub fn accumulated_value(radiance: Vec3A) -> Vec3A {
     if radiance.is_finite() {
-        radiance.clamp(Vec3::ZERO, Vec3::splat(SAMPLE_MAX))
+        radiance.clamp(Vec3A::ZERO, Vec3A::splat(SAMPLE_MAX))
     } else {
-        Vec3::ZERO
+        Vec3A::ZERO
     }
 }

@@ -8,7 +8,7 @@
 
 use std::f32::consts::{PI, TAU};
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3A};
 use pathlight_core::gpu::{
     FLAG_CAPS, GpuFrameParams, KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE,
 };
@@ -23,13 +23,13 @@ use crate::scene::CpuScene;
 #[derive(Debug, Clone, Copy)]
 pub struct LightSample {
     /// Unit direction from the shading point to the light.
-    pub wi: Vec3,
+    pub wi: Vec3A,
     /// The sampled point on the light (unused for the environment).
-    pub point: Vec3,
+    pub point: Vec3A,
     /// False for the environment (infinitely far).
     pub finite: bool,
     /// Emitted radiance towards the shading point.
-    pub radiance: Vec3,
+    pub radiance: Vec3A,
     /// Solid-angle density, including the choice of the light.
     pub pdf: f32,
     /// False when the sample cannot contribute (back side, zero density).
@@ -37,10 +37,10 @@ pub struct LightSample {
 }
 
 const INVALID: LightSample = LightSample {
-    wi: Vec3::ZERO,
-    point: Vec3::ZERO,
+    wi: Vec3A::ZERO,
+    point: Vec3A::ZERO,
     finite: false,
-    radiance: Vec3::ZERO,
+    radiance: Vec3A::ZERO,
     pdf: 0.0,
     valid: false,
 };
@@ -48,13 +48,13 @@ const INVALID: LightSample = LightSample {
 /// Density of choosing the environment and direction `wi` from a point with normal `n`
 /// (on the side light is gathered from). Twin of WGSL `env_pdf`.
 #[inline(always)]
-pub fn env_pdf(params: &GpuFrameParams, n: Vec3, wi: Vec3) -> f32 {
+pub fn env_pdf(params: &GpuFrameParams, n: Vec3A, wi: Vec3A) -> f32 {
     params.env_pmf * n.dot(wi).max(0.0) / PI
 }
 
 /// `1 - cos` of the half-angle of the cone a sphere subtends from `p`, or a negative value
 /// when `p` is inside it. Twin of WGSL `sphere_cone`.
-fn sphere_cone(center: Vec3, radius: f32, p: Vec3) -> f32 {
+fn sphere_cone(center: Vec3A, radius: f32, p: Vec3A) -> f32 {
     let d2 = (center - p).length_squared();
     let r2 = radius * radius;
     if d2 <= r2 * 1.0001 {
@@ -74,9 +74,9 @@ pub fn light_pdf(
     params: &GpuFrameParams,
     object: u32,
     primitive: u32,
-    p: Vec3,
-    p_light: Vec3,
-    n_light: Vec3,
+    p: Vec3A,
+    p_light: Vec3A,
+    n_light: Vec3A,
 ) -> f32 {
     let o = &scene.gpu.objects[object as usize];
     let entry = if o.kind == KIND_MESH {
@@ -89,7 +89,7 @@ pub fn light_pdf(
     let d2 = to_light.length_squared();
     let cos_l = n_light.dot(-to_light).abs() / d2.sqrt();
     if o.kind == KIND_SPHERE {
-        let one_minus_cos = sphere_cone(Vec3::from_slice(&o.a), o.a[3], p);
+        let one_minus_cos = sphere_cone(Vec3A::from_slice(&o.a), o.a[3], p);
         if one_minus_cos > 0.0 {
             return pmf / (TAU * one_minus_cos);
         }
@@ -109,12 +109,12 @@ fn sample_shape(
     scene: &CpuScene,
     object: u32,
     primitive: u32,
-    p: Vec3,
+    p: Vec3A,
     u: Vec2,
     u_part: f32,
-) -> (Vec3, Vec3, f32) {
+) -> (Vec3A, Vec3A, f32) {
     let o = &scene.gpu.objects[object as usize];
-    let [a, b, c] = [o.a, o.b, o.c].map(|v| Vec3::from_slice(&v));
+    let [a, b, c] = [o.a, o.b, o.c].map(|v| Vec3A::from_slice(&v));
     match o.kind {
         KIND_QUAD => (
             a + u.x * b + u.y * c,
@@ -128,13 +128,16 @@ fn sample_shape(
                 let cos_theta = 1.0 - u.x * one_minus_cos;
                 let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
                 let (sin, cos) = sin_cos_turns(u.y);
-                let dir = Frame::around((a - p).normalize()).to_world(Vec3::new(
+                let dir = Frame::around((a - p).normalize()).to_world(Vec3A::new(
                     sin_theta * cos,
                     sin_theta * sin,
                     cos_theta,
                 ));
-                let ray = Ray { origin: p, dir };
-                let mut t = intersect_sphere(a, radius, &ray, 1e30);
+                let ray = Ray {
+                    origin: p.into(),
+                    dir: dir.into(),
+                };
+                let mut t = intersect_sphere(a.into(), radius, &ray, 1e30);
                 if t == MISS {
                     t = (a - p).dot(dir);
                 }
@@ -172,7 +175,7 @@ fn sample_shape(
             }
         }
         _ => {
-            let [v0, v1, v2] = scene.gpu.triangle(primitive);
+            let [v0, v1, v2] = scene.gpu.triangle(primitive).map(Vec3A::from);
             let su = u.x.sqrt();
             let (b1, b2) = (1.0 - su, u.y * su);
             let cross = (v1 - v0).cross(v2 - v0);
@@ -191,18 +194,18 @@ fn sample_shape(
 pub fn sample_light(
     cpu_scene: &CpuScene,
     params: &GpuFrameParams,
-    p: Vec3,
-    n: Vec3,
+    p: Vec3A,
+    n: Vec3A,
     u_select: f32,
     u: Vec2,
 ) -> LightSample {
     if u_select < params.env_pmf {
         let wi = Frame::around(n).to_world(sample_cosine_hemisphere(u));
-        let radiance = Vec3::from(params.environment);
+        let radiance = Vec3A::from(params.environment);
         let pdf = env_pdf(params, n, wi);
         return LightSample {
             wi,
-            point: Vec3::ZERO,
+            point: Vec3A::ZERO,
             finite: false,
             radiance,
             pdf,
@@ -246,7 +249,7 @@ pub fn sample_light(
     } else {
         pmf * density * distance * distance / cos_l
     };
-    let radiance = Vec3::from(scene.materials[o.material as usize].emission);
+    let radiance = Vec3A::from(scene.materials[o.material as usize].emission);
     LightSample {
         wi,
         point: q,

@@ -3,7 +3,7 @@
 
 use std::ops::Range;
 
-use glam::Vec3;
+use glam::Vec3A;
 use pathlight_core::Tracer;
 use pathlight_core::gpu::GpuFrameParams;
 use pathlight_core::packet::{PACKET, RayPacket};
@@ -67,7 +67,7 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
         }
         let hits = tracer.intersect_packet(&packet);
         shadows.active = 0;
-        let mut unblocked = [Vec3::ZERO; PACKET];
+        let mut unblocked = [Vec3A::ZERO; PACKET];
         for (l, lane) in lanes.iter_mut().enumerate() {
             if let Some((_, path)) = lane
                 && let Some(shadow) = path.step(scene, params, hits.hit(l))

@@ -2,40 +2,40 @@
 
 use std::f32::consts::TAU;
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3A};
 
 /// An orthonormal basis. Twin of WGSL `frame_around` (a `mat3x3f` there).
 #[derive(Debug, Clone, Copy)]
 pub struct Frame {
     /// Tangent.
-    pub t: Vec3,
+    pub t: Vec3A,
     /// Bitangent.
-    pub b: Vec3,
+    pub b: Vec3A,
     /// Normal.
-    pub n: Vec3,
+    pub n: Vec3A,
 }
 
 impl Frame {
     /// Basis around unit `n` (Duff et al., JCGT 2017). Twin of WGSL `frame_around`.
-    pub fn around(n: Vec3) -> Self {
+    pub fn around(n: Vec3A) -> Self {
         let s = if n.z >= 0.0 { 1.0 } else { -1.0 };
         let a = -1.0 / (s + n.z);
         let b = n.x * n.y * a;
         Self {
-            t: Vec3::new(1.0 + s * n.x * n.x * a, s * b, -s * n.x),
-            b: Vec3::new(b, s + n.y * n.y * a, -n.y),
+            t: Vec3A::new(1.0 + s * n.x * n.x * a, s * b, -s * n.x),
+            b: Vec3A::new(b, s + n.y * n.y * a, -n.y),
             n,
         }
     }
 
     /// World direction of local `v`.
-    pub fn to_world(&self, v: Vec3) -> Vec3 {
+    pub fn to_world(&self, v: Vec3A) -> Vec3A {
         self.t * v.x + self.b * v.y + self.n * v.z
     }
 
     /// Local coordinates of world `v`.
-    pub fn to_local(&self, v: Vec3) -> Vec3 {
-        Vec3::new(v.dot(self.t), v.dot(self.b), v.dot(self.n))
+    pub fn to_local(&self, v: Vec3A) -> Vec3A {
+        Vec3A::new(v.dot(self.t), v.dot(self.b), v.dot(self.n))
     }
 }
 
@@ -65,18 +65,18 @@ pub fn sin_cos_turns(turns: f32) -> (f32, f32) {
 
 /// Cosine-weighted direction about +z. Twin of WGSL `sample_cosine_hemisphere`.
 #[inline(always)]
-pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
+pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3A {
     let r = u.x.sqrt();
     let (sin, cos) = sin_cos_turns(u.y);
-    Vec3::new(r * cos, r * sin, (1.0 - u.x).max(0.0).sqrt())
+    Vec3A::new(r * cos, r * sin, (1.0 - u.x).max(0.0).sqrt())
 }
 
 /// Uniform direction on the unit sphere. Twin of WGSL `sample_uniform_sphere`.
-pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
+pub fn sample_uniform_sphere(u: Vec2) -> Vec3A {
     let z = 1.0 - 2.0 * u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
     let (sin, cos) = sin_cos_turns(u.y);
-    Vec3::new(r * cos, r * sin, z)
+    Vec3A::new(r * cos, r * sin, z)
 }
 
 /// Uniform point on the unit disk (polar). Twin of WGSL `sample_disk`.

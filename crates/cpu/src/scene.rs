@@ -1,6 +1,6 @@
 //! The scene as the CPU backend shades it.
 
-use glam::Vec3;
+use glam::Vec3A;
 use pathlight_core::GpuScene;
 use pathlight_core::gpu::{GpuObject, KIND_QUAD};
 
@@ -12,7 +12,7 @@ pub struct CpuScene {
     /// The buffers the WGSL twin reads.
     pub gpu: GpuScene,
     /// Per object: a quad's unit normal and area; zero for other kinds.
-    quads: Vec<(Vec3, f32)>,
+    quads: Vec<(Vec3A, f32)>,
 }
 
 impl CpuScene {
@@ -23,9 +23,9 @@ impl CpuScene {
             .iter()
             .map(|o| {
                 if o.kind != KIND_QUAD {
-                    return (Vec3::ZERO, 0.0);
+                    return (Vec3A::ZERO, 0.0);
                 }
-                let normal = Vec3::from_slice(&o.b).cross(Vec3::from_slice(&o.c));
+                let normal = Vec3A::from_slice(&o.b).cross(Vec3A::from_slice(&o.c));
                 (normal.normalize(), normal.length())
             })
             .collect();
@@ -34,7 +34,7 @@ impl CpuScene {
 
     /// The unit normal of quad `object` (the direction of `edge_u x edge_v`).
     #[inline(always)]
-    pub fn quad_normal(&self, object: u32) -> Vec3 {
+    pub fn quad_normal(&self, object: u32) -> Vec3A {
         self.quads[object as usize].0
     }
 

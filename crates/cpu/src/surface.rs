@@ -2,7 +2,7 @@
 
 use std::f32::consts::{PI, TAU};
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3A};
 use pathlight_core::GpuScene;
 use pathlight_core::gpu::{
     FLAG_CAPS, FLAG_FLAT, GpuMaterial, GpuTextureInfo, KIND_CYLINDER, KIND_QUAD, KIND_SPHERE,
@@ -16,11 +16,11 @@ use crate::scene::CpuScene;
 #[derive(Debug, Clone, Copy)]
 pub struct Surface {
     /// World position.
-    pub position: Vec3,
+    pub position: Vec3A,
     /// Geometric normal on the shape's front side.
-    pub ng: Vec3,
+    pub ng: Vec3A,
     /// Shading normal, in the hemisphere of `ng`.
-    pub ns: Vec3,
+    pub ns: Vec3A,
     /// Texture coordinates.
     pub uv: Vec2,
     /// Material index.
@@ -37,14 +37,14 @@ fn srgb_to_linear(c: f32) -> f32 {
 }
 
 /// Twin of WGSL `texel`.
-fn texel(scene: &GpuScene, info: &GpuTextureInfo, x: u32, y: u32) -> Vec3 {
+fn texel(scene: &GpuScene, info: &GpuTextureInfo, x: u32, y: u32) -> Vec3A {
     let packed = scene.texels[(info.offset + y * info.width + x) as usize];
     let [r, g, b, _] = packed.to_le_bytes();
-    Vec3::new(r as f32, g as f32, b as f32).map(|c| srgb_to_linear(c / 255.0))
+    Vec3A::new(r as f32, g as f32, b as f32).map(|c| srgb_to_linear(c / 255.0))
 }
 
 /// Bilinear lookup, u wraps, v clamps. Twin of WGSL `sample_texture`.
-fn sample_texture(scene: &GpuScene, index: u32, uv: Vec2) -> Vec3 {
+fn sample_texture(scene: &GpuScene, index: u32, uv: Vec2) -> Vec3A {
     let info = &scene.textures[index as usize];
     let size = Vec2::new(info.width as f32, info.height as f32);
     let p = Vec2::new(uv.x - uv.x.floor(), uv.y.clamp(0.0, 1.0)) * size - 0.5;
@@ -61,11 +61,11 @@ fn sample_texture(scene: &GpuScene, index: u32, uv: Vec2) -> Vec3 {
 
 /// The material's colour at `uv`. Twin of WGSL `base_color`.
 #[inline(always)]
-pub fn base_color(scene: &GpuScene, material: &GpuMaterial, uv: Vec2) -> Vec3 {
+pub fn base_color(scene: &GpuScene, material: &GpuMaterial, uv: Vec2) -> Vec3A {
     if material.texture >= 0 {
         sample_texture(scene, material.texture as u32, uv)
     } else {
-        Vec3::from(material.base_color)
+        Vec3A::from(material.base_color)
     }
 }
 
@@ -77,12 +77,12 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
     let scene = &cpu_scene.gpu;
     let o = &scene.objects[hit.object as usize];
     let textured = scene.materials[o.material as usize].texture >= 0;
-    let [a, b] = [o.a, o.b].map(|v| Vec3::from_slice(&v));
-    let p = ray.origin + hit.t * ray.dir;
+    let [a, b] = [o.a, o.b].map(|v| Vec3A::from_slice(&v));
+    let p = Vec3A::from(ray.origin) + hit.t * Vec3A::from(ray.dir);
     let mut s = Surface {
         position: p,
-        ng: Vec3::Y,
-        ns: Vec3::Y,
+        ng: Vec3A::Y,
+        ns: Vec3A::Y,
         uv: Vec2::ZERO,
         material: o.material,
     };
@@ -131,11 +131,11 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
             let i = 3 * hit.primitive as usize;
             let [v0, v1, v2] = [0, 1, 2].map(|k| scene.vertices[i + k]);
             let b0 = 1.0 - hit.b1 - hit.b2;
-            let [p0, p1, p2] = [v0, v1, v2].map(|v| Vec3::from(v.position));
+            let [p0, p1, p2] = [v0, v1, v2].map(|v| Vec3A::from(v.position));
             s.ng = (p1 - p0).cross(p2 - p0).normalize();
-            let n = b0 * Vec3::from(v0.normal)
-                + hit.b1 * Vec3::from(v1.normal)
-                + hit.b2 * Vec3::from(v2.normal);
+            let n = b0 * Vec3A::from(v0.normal)
+                + hit.b1 * Vec3A::from(v1.normal)
+                + hit.b2 * Vec3A::from(v2.normal);
             if o.flags & FLAG_FLAT != 0 || n.dot(n) < 1e-12 {
                 s.ns = s.ng;
             } else {

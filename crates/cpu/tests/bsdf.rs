@@ -5,7 +5,7 @@
 
 use std::f32::consts::PI;
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3A};
 use pathlight_core::gpu::GpuMaterial;
 use pathlight_cpu::bsdf::{eval_bsdf, fresnel_conductor, fresnel_dielectric, ggx_d, sample_bsdf};
 use pathlight_cpu::sampling::sample_uniform_sphere;
@@ -68,27 +68,27 @@ fn mean_and_error(values: &[f64]) -> (f64, f64) {
 
 fn surface() -> Surface {
     Surface {
-        position: Vec3::ZERO,
-        ng: Vec3::Z,
-        ns: Vec3::Z,
+        position: Vec3A::ZERO,
+        ng: Vec3A::Z,
+        ns: Vec3A::Z,
         uv: Vec2::ZERO,
         material: 0,
     }
 }
 
 /// Outgoing directions above and (for transmission) below the surface.
-fn outgoing() -> Vec<Vec3> {
+fn outgoing() -> Vec<Vec3A> {
     vec![
-        Vec3::new(0.0, 0.0, 1.0),
-        Vec3::new(0.6, 0.0, 0.8),
-        Vec3::new(0.3, 0.9, 0.2).normalize(),
-        Vec3::new(0.2, -0.1, -0.9).normalize(),
+        Vec3A::new(0.0, 0.0, 1.0),
+        Vec3A::new(0.6, 0.0, 0.8),
+        Vec3A::new(0.3, 0.9, 0.2).normalize(),
+        Vec3A::new(0.2, -0.1, -0.9).normalize(),
     ]
 }
 
-fn sample(rng: &mut StdRng, m: &GpuMaterial, wo: Vec3) -> pathlight_cpu::bsdf::BsdfSample {
+fn sample(rng: &mut StdRng, m: &GpuMaterial, wo: Vec3A) -> pathlight_cpu::bsdf::BsdfSample {
     let u = Vec2::new(rng.random(), rng.random());
-    sample_bsdf(m, Vec3::ONE, &surface(), wo, rng.random(), rng.random(), u)
+    sample_bsdf(m, Vec3A::ONE, &surface(), wo, rng.random(), rng.random(), u)
 }
 
 #[test]
@@ -101,7 +101,7 @@ fn samples_agree_with_eval_and_pdf() {
                 if !bs.valid || bs.delta {
                     continue;
                 }
-                let e = eval_bsdf(&m, Vec3::ONE, &surface(), wo, bs.wi);
+                let e = eval_bsdf(&m, Vec3A::ONE, &surface(), wo, bs.wi);
                 assert!(
                     (bs.pdf - e.pdf).abs() <= 1e-3 * e.pdf,
                     "{name}: pdf {} vs eval {}",
@@ -128,7 +128,7 @@ fn densities_integrate_to_the_non_delta_probability() {
             let integrals: Vec<f64> = (0..N)
                 .map(|_| {
                     let wi = sample_uniform_sphere(Vec2::new(rng.random(), rng.random()));
-                    f64::from(eval_bsdf(&m, Vec3::ONE, &surface(), wo, wi).pdf)
+                    f64::from(eval_bsdf(&m, Vec3A::ONE, &surface(), wo, wi).pdf)
                         * 4.0
                         * f64::from(PI)
                 })
@@ -196,12 +196,12 @@ fn fresnel_and_ggx_closed_forms() {
         "ior 1 reflects nothing"
     );
     // Conductor at normal incidence: ((eta - 1)^2 + k^2) / ((eta + 1)^2 + k^2); gold.
-    let eta = Vec3::new(0.143_036, 0.375_307, 1.442_05);
-    let k = Vec3::new(3.983, 2.385_56, 1.603_36);
+    let eta = Vec3A::new(0.143_036, 0.375_307, 1.442_05);
+    let k = Vec3A::new(3.983, 2.385_56, 1.603_36);
     let f0 = ((eta - 1.0) * (eta - 1.0) + k * k) / ((eta + 1.0) * (eta + 1.0) + k * k);
     assert!((fresnel_conductor(1.0, eta, k) - f0).abs().max_element() < 1e-5);
     assert!(
-        (fresnel_conductor(0.0, eta, k) - Vec3::ONE)
+        (fresnel_conductor(0.0, eta, k) - Vec3A::ONE)
             .abs()
             .max_element()
             < 1e-5,
