@@ -15,6 +15,7 @@ use glam::{Vec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::builder::build_bvh2;
+use rayon::prelude::*;
 
 use crate::gpu::{
     FLAG_CAPS, FLAG_FLAT, GpuBvhNode, GpuLight, GpuMaterial, GpuObject, GpuPrimitive,
@@ -222,13 +223,15 @@ impl GpuScene {
             out.objects.push(gpu_object(object, &object_bounds));
             let i = i as u32;
             if let Shape::Mesh(mesh) = &object.shape {
-                for t in 0..mesh.indices.len() {
-                    refs.push(PrimitiveRef {
-                        object: i,
-                        triangle: t as u32,
-                    });
-                    bounds.push(triangle_bounds(mesh, t));
-                }
+                refs.extend((0..mesh.indices.len() as u32).map(|t| PrimitiveRef {
+                    object: i,
+                    triangle: t,
+                }));
+                bounds.par_extend(
+                    (0..mesh.indices.len())
+                        .into_par_iter()
+                        .map(|t| triangle_bounds(mesh, t)),
+                );
             } else {
                 refs.push(PrimitiveRef {
                     object: i,
@@ -274,7 +277,8 @@ impl GpuScene {
 
     /// Fills the vertex buffer, each mesh's triangles together in the order the leaves hold
     /// them (so that a leaf's triangles lie side by side for shading too), and the
-    /// primitives in leaf order.
+    /// primitives in leaf order. One pass numbers the triangles; both buffers are then
+    /// written in parallel, each in its own order (a 1M-triangle mesh: 150 MB).
     fn lay_out_primitives(&mut self, scene: &Scene, leaf_order: &[PrimitiveRef]) {
         // Per object, the vertex-buffer triangle its next leaf-order triangle takes.
         let mut next = vec![0u32; scene.objects.len()];
@@ -288,36 +292,65 @@ impl GpuScene {
                 total += count;
             }
         }
-        self.vertices = vec![GpuVertex::zeroed(); 3 * total as usize];
-        self.primitives = leaf_order
+        // Per leaf, its vertex-buffer triangle; per vertex-buffer triangle, its leaf's.
+        let mut held = vec![
+            PrimitiveRef {
+                object: 0,
+                triangle: 0,
+            };
+            total as usize
+        ];
+        let slots: Vec<u32> = leaf_order
             .iter()
             .map(|p| {
-                let mut primitive = GpuPrimitive {
-                    object: p.object,
-                    triangle: NO_TRIANGLE,
-                    ..GpuPrimitive::zeroed()
-                };
-                let Shape::Mesh(mesh) = &scene.objects[p.object as usize].shape else {
-                    return primitive;
-                };
-                let triangle = next[p.object as usize];
+                if p.triangle == NO_TRIANGLE {
+                    return NO_TRIANGLE;
+                }
+                let slot = next[p.object as usize];
                 next[p.object as usize] += 1;
-                let corners = mesh.indices[p.triangle as usize];
-                for (k, v) in corners.into_iter().enumerate() {
+                held[slot as usize] = *p;
+                slot
+            })
+            .collect();
+        let mesh_of = |p: &PrimitiveRef| match &scene.objects[p.object as usize].shape {
+            Shape::Mesh(mesh) => Some(mesh),
+            _ => None,
+        };
+        self.vertices = held
+            .par_iter()
+            .map(|p| {
+                let Some(mesh) = mesh_of(p) else {
+                    return [GpuVertex::zeroed(); 3]; // Not reached: every slot is a mesh's.
+                };
+                mesh.indices[p.triangle as usize].map(|v| {
                     let v = v as usize;
                     let uv = mesh.uvs.get(v).copied().unwrap_or_default();
-                    self.vertices[3 * triangle as usize + k] = GpuVertex {
+                    GpuVertex {
                         position: mesh.positions[v].to_array(),
                         u: uv.x,
                         normal: mesh.normals.get(v).copied().unwrap_or_default().to_array(),
                         v: uv.y,
-                    };
+                    }
+                })
+            })
+            .collect::<Vec<[GpuVertex; 3]>>()
+            .into_flattened();
+        self.primitives = leaf_order
+            .par_iter()
+            .zip(slots)
+            .map(|(p, slot)| {
+                let mut primitive = GpuPrimitive {
+                    object: p.object,
+                    triangle: slot,
+                    ..GpuPrimitive::zeroed()
+                };
+                if let Some(mesh) = mesh_of(p).filter(|_| slot != NO_TRIANGLE) {
+                    let corners = mesh.indices[p.triangle as usize];
+                    let [v0, v1, v2] = corners.map(|v| mesh.positions[v as usize]);
+                    primitive.v0 = v0.to_array();
+                    primitive.e1 = (v1 - v0).to_array();
+                    primitive.e2 = (v2 - v0).to_array();
                 }
-                let [v0, v1, v2] = corners.map(|v| mesh.positions[v as usize]);
-                primitive.v0 = v0.to_array();
-                primitive.e1 = (v1 - v0).to_array();
-                primitive.e2 = (v2 - v0).to_array();
-                primitive.triangle = triangle;
                 primitive
             })
             .collect();
