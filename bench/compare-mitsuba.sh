@@ -2,10 +2,10 @@
 # Times pathlight and Mitsuba 3 on the same machine, in one run: cornell-spheres at 512x512,
 # 64 spp, the scene's max_depth. pathlight: whole-process time of `pathlight render` (CPU
 # backend with its default Sobol sampler and with the independent sampler Mitsuba uses here,
-# and the GPU backend on whatever adapter is found). Mitsuba: render time alone (llvm_ad_rgb,
-# after one untimed render that compiles its kernels), median of 3. Quality: each image's
-# relMSE against the stored converged reference (scenes/refs/images), the same measure as
-# the reference tests.
+# median of 3 each; and one run of the GPU backend on whatever adapter is found). Mitsuba:
+# render time alone (llvm_ad_rgb, after one untimed render that compiles its kernels),
+# median of 3. Quality: each image's relMSE against the stored converged reference
+# (scenes/refs/images), the same measure as the reference tests.
 #
 # Installs what it needs: Debian's libllvm19 and python3-venv (apt-get, as root or with
 # sudo), then Mitsuba and NumPy from pip into a virtual environment (MITSUBA_VENV, default
@@ -32,22 +32,26 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 echo "load: $(cut -d' ' -f1-3 /proc/loadavg) (a busy machine halves both sides)"
 
-# Whole-process wall time of one pathlight render into $out/$1.exr, in seconds.
+# Whole-process wall time of a pathlight render into $out/$2.exr, in seconds: the median of
+# $1 runs.
 time_pathlight() {
-    local image=$1 start end
-    shift
-    start=$(date +%s.%N)
-    ./target/release/pathlight render "scenes/refs/$SCENE.toml" --width $RES --height $RES \
-        --spp $SPP -o "$out/$image.exr" "$@" 2>"$out/log" || { cat "$out/log"; exit 1; }
-    end=$(date +%s.%N)
-    awk "BEGIN { print $end - $start }"
+    local runs=$1 image=$2 start end run times=()
+    shift 2
+    for run in $(seq "$runs"); do
+        start=$(date +%s.%N)
+        ./target/release/pathlight render "scenes/refs/$SCENE.toml" --width $RES --height $RES \
+            --spp $SPP -o "$out/$image.exr" "$@" 2>"$out/log" || { cat "$out/log"; exit 1; }
+        end=$(date +%s.%N)
+        times+=("$(awk "BEGIN { print $end - $start }")")
+    done
+    printf '%s\n' "${times[@]}" | sort -g | sed -n "$(((runs + 1) / 2))p"
 }
 
 samples=$((RES * RES * SPP))
-cpu_s=$(time_pathlight sobol --backend cpu)
-cpu_ind_s=$(time_pathlight independent --backend cpu --sampler independent)
+cpu_s=$(time_pathlight 3 sobol --backend cpu)
+cpu_ind_s=$(time_pathlight 3 independent --backend cpu --sampler independent)
 if [ "${1:-}" != "--skip-gpu" ]; then
-    gpu_s=$(time_pathlight gpu --backend gpu)
+    gpu_s=$(time_pathlight 1 gpu --backend gpu)
     adapter=$(grep -o 'adapter: .*' "$out/log" | head -1)
 fi
 mitsuba_json=$("$VENV/bin/python" tools/mitsuba_refs.py time $SCENE --res $RES --spp $SPP \
