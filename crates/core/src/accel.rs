@@ -357,7 +357,9 @@ impl GpuScene {
     }
 
     /// Surface area of light-table entry `(object, primitive)`: the whole shape, or
-    /// triangle `primitive` of a mesh. Twin of WGSL `emitter_area`.
+    /// triangle `primitive` of a mesh. Twin of WGSL `emitter_area`. Inlined into the CPU
+    /// backend's row renderer, which a call would make save its vector registers.
+    #[inline(always)]
     pub fn emitter_area(&self, object: &GpuObject, primitive: u32) -> f32 {
         let [a, b, c] = [object.a, object.b, object.c].map(|v| Vec3::from_slice(&v));
         match object.kind {

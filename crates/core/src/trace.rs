@@ -206,6 +206,7 @@ pub fn intersect_triangle_edges(
 
 impl GpuScene {
     /// Triangle `i`'s corner positions.
+    #[inline(always)]
     pub fn triangle(&self, i: u32) -> [Vec3; 3] {
         let i = 3 * i as usize;
         [0, 1, 2].map(|k| Vec3::from(self.vertices[i + k].position))

@@ -62,6 +62,7 @@ const INVALID: BsdfSample = BsdfSample {
 
 /// Unpolarised dielectric Fresnel reflectance; `eta` = n_transmitted / n_incident, `cos_i`
 /// >= 0. Twin of WGSL `fresnel_dielectric`.
+#[inline(always)]
 pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
     if sin2_t >= 1.0 {
@@ -104,6 +105,7 @@ fn specular_reflectance(m: &GpuMaterial, color: Vec3A, cos_i: f32) -> Vec3A {
 }
 
 /// GGX normal distribution, local `m`. Twin of WGSL `ggx_d`.
+#[inline(always)]
 pub fn ggx_d(m: Vec3A, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     let t = (m.x * m.x + m.y * m.y) / a2 + m.z * m.z;
@@ -111,6 +113,7 @@ pub fn ggx_d(m: Vec3A, alpha: f32) -> f32 {
 }
 
 /// Smith masking of one direction (either hemisphere). Twin of WGSL `ggx_g1`.
+#[inline(always)]
 pub fn ggx_g1(w: Vec3A, alpha: f32) -> f32 {
     let z2 = w.z * w.z;
     if z2 <= 0.0 {
@@ -143,11 +146,13 @@ pub fn ggx_sample_visible(wo: Vec3A, alpha: f32, u: Vec2) -> Vec3A {
 }
 
 /// Density of `ggx_sample_visible` producing `m`. Twin of WGSL `ggx_pdf_visible`.
+#[inline(always)]
 fn ggx_pdf_visible(wo: Vec3A, m: Vec3A, alpha: f32) -> f32 {
     ggx_g1(wo, alpha) * wo.dot(m).abs() * ggx_d(m, alpha) / wo.z.abs()
 }
 
 /// Lobe weights (diffuse, specular, transmission). Twin of WGSL `lobe_weights`.
+#[inline(always)]
 fn lobe_weights(m: &GpuMaterial) -> Vec3A {
     Vec3A::new(
         (1.0 - m.specular_rate - m.refract_rate).max(0.0),
@@ -158,6 +163,7 @@ fn lobe_weights(m: &GpuMaterial) -> Vec3A {
 
 /// Dielectric Fresnel for local `wo` and microfacet `m` with the inside IOR `ior`
 /// (either side). Twin of WGSL `fresnel_dielectric_local`.
+#[inline(always)]
 fn fresnel_dielectric_local(cos_om: f32, ior: f32) -> f32 {
     if cos_om >= 0.0 {
         fresnel_dielectric(cos_om, ior)
