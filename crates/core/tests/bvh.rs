@@ -1,6 +1,6 @@
 //! The BVH: structure validated after every build, and both traversals (the WGSL twin in
 //! `trace` and the CPU's 4-wide `WideBvh`) compared with brute force on random rays, for
-//! random, empty and degenerate scenes.
+//! random, empty and degenerate scenes; and the build independent of the thread count.
 
 use glam::{Vec2, Vec3};
 use pathlight_core::gpu::{GpuBvhNode, KIND_MESH, NO_TRIANGLE};
@@ -488,4 +488,39 @@ fn coincident_triangles_build_and_trace() {
     let mut rng = StdRng::seed_from_u64(5);
     let rays: Vec<Ray> = (0..200).map(|_| random_ray(&mut rng, 0.5)).collect();
     assert!(assert_same(&gpu, &rays) > 20);
+}
+
+#[test]
+fn the_build_does_not_depend_on_the_thread_count() {
+    // obvhs' build and the buffer fill run on rayon: one thread and four give the same tree
+    // and buffers, so a seeded render is the same image on any machine.
+    let mut rng = StdRng::seed_from_u64(13);
+    let mut objects = random_objects(&mut rng, 40);
+    objects.push(Object {
+        name: "big".into(),
+        material: 0,
+        shape: Shape::Mesh(random_mesh(&mut rng, 30_000, Vec3::ZERO)),
+    });
+    let scene = scene_of(objects);
+    let build_on = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool")
+            .install(|| GpuScene::build(&scene))
+    };
+    let (one, four) = (build_on(1), build_on(4));
+    validate(&four);
+    assert!(same_bytes(&one.nodes, &four.nodes), "nodes differ");
+    assert!(
+        same_bytes(&one.primitives, &four.primitives),
+        "primitives differ"
+    );
+    assert!(same_bytes(&one.vertices, &four.vertices), "vertices differ");
+    assert!(same_bytes(&one.objects, &four.objects), "objects differ");
+}
+
+/// Whether two buffers hold the same bytes.
+fn same_bytes<T: bytemuck::Pod>(a: &[T], b: &[T]) -> bool {
+    bytemuck::cast_slice::<T, u8>(a) == bytemuck::cast_slice::<T, u8>(b)
 }
