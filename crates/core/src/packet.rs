@@ -29,7 +29,7 @@ pub const PACKET: usize = 32;
 const MIN_SHARED_RAYS: u32 = 5;
 
 /// A bit mask of a packet's lanes (bit `l` is lane `l`).
-pub type Lanes = u64;
+pub type Lanes = u32;
 const _: () = assert!(PACKET <= Lanes::BITS as usize);
 
 /// Up to [`PACKET`] rays to trace together.
