@@ -142,14 +142,25 @@ impl PacketHits {
         primitive: u32,
         shape: &impl ShapeTest,
     ) {
+        // Every lane is written, blended by a bit mask the compiler cannot see is all ones
+        // or all zeros: a select of the lane's own value would become masked stores, which
+        // AMD CPUs run slowly under AVX2 (the x86-64-v3 level).
+        let opaque = std::hint::black_box(0u32);
+        let blend = |new: u32, old: u32, take: bool| {
+            let m = u32::from(take).wrapping_neg() ^ opaque;
+            (new & m) | (old & !m)
+        };
+        let blend_f = |new: f32, old: f32, take: bool| {
+            f32::from_bits(blend(new.to_bits(), old.to_bits(), take))
+        };
         for l in 0..PACKET {
             let (t, b1, b2) = shape.intersect(&rays.ray(l), self.t[l]);
             let take = (lanes >> l) & 1 != 0 && t < self.t[l];
-            self.t[l] = if take { t } else { self.t[l] };
-            self.b1[l] = if take { b1 } else { self.b1[l] };
-            self.b2[l] = if take { b2 } else { self.b2[l] };
-            self.object[l] = if take { object } else { self.object[l] };
-            self.primitive[l] = if take { primitive } else { self.primitive[l] };
+            self.t[l] = blend_f(t, self.t[l], take);
+            self.b1[l] = blend_f(b1, self.b1[l], take);
+            self.b2[l] = blend_f(b2, self.b2[l], take);
+            self.object[l] = blend(object, self.object[l], take);
+            self.primitive[l] = blend(primitive, self.primitive[l], take);
         }
     }
 
