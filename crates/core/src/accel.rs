@@ -344,7 +344,7 @@ impl GpuScene {
                     triangle: slot,
                     ..GpuPrimitive::zeroed()
                 };
-                if let Some(mesh) = mesh_of(p).filter(|_| slot != NO_TRIANGLE) {
+                if let Some(mesh) = mesh_of(p) {
                     let corners = mesh.indices[p.triangle as usize];
                     let [v0, v1, v2] = corners.map(|v| mesh.positions[v as usize]);
                     primitive.v0 = v0.to_array();

@@ -19,6 +19,18 @@ pub struct Ray {
     pub dir: Vec3,
 }
 
+impl Ray {
+    /// The ray from `origin` along `dir`, from any glam 3-vector (the CPU backend shades in
+    /// `Vec3A`).
+    #[inline(always)]
+    pub fn new(origin: impl Into<Vec3>, dir: impl Into<Vec3>) -> Self {
+        Self {
+            origin: origin.into(),
+            dir: dir.into(),
+        }
+    }
+}
+
 /// The nearest hit of a ray (WGSL `Hit`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hit {

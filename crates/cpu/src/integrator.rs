@@ -26,15 +26,6 @@ fn offset_origin(p: Vec3A, ng: Vec3A, dir: Vec3A) -> Vec3A {
     p + if dir.dot(ng) > 0.0 { ng } else { -ng } * eps
 }
 
-/// The ray from `origin` along `dir`.
-#[inline(always)]
-fn ray_from(origin: Vec3A, dir: Vec3A) -> Ray {
-    Ray {
-        origin: origin.into(),
-        dir: dir.into(),
-    }
-}
-
 /// Camera ray through a jittered point of pixel (x, y). Twin of WGSL `camera_ray`.
 #[inline(always)]
 fn camera_ray(params: &GpuFrameParams, x: u32, y: u32, sampler: &mut Sampler) -> Ray {
@@ -44,10 +35,7 @@ fn camera_ray(params: &GpuFrameParams, x: u32, y: u32, sampler: &mut Sampler) ->
     let dir = Vec3A::from(params.camera_forward)
         + ndc_x * Vec3A::from(params.camera_right)
         + ndc_y * Vec3A::from(params.camera_up);
-    Ray {
-        origin: params.camera_position.into(),
-        dir: dir.normalize().into(),
-    }
+    Ray::new(params.camera_position, dir.normalize())
 }
 
 /// The shadow ray testing whether anything blocks the light sample `ls` from surface point
@@ -58,12 +46,12 @@ fn camera_ray(params: &GpuFrameParams, x: u32, y: u32, sampler: &mut Sampler) ->
 fn shadow_ray(p: Vec3A, ng: Vec3A, ls: &LightSample) -> (Ray, f32) {
     let origin = offset_origin(p, ng, ls.wi);
     if !ls.finite {
-        return (ray_from(origin, ls.wi), T_MAX);
+        return (Ray::new(origin, ls.wi), T_MAX);
     }
     let to_light = ls.point - origin;
     let distance = to_light.length();
     (
-        ray_from(origin, to_light / distance),
+        Ray::new(origin, to_light / distance),
         distance * (1.0 - 1e-4),
     )
 }
@@ -240,7 +228,7 @@ impl Path {
             }
             self.throughput /= q;
         }
-        self.ray = ray_from(offset_origin(s.position, s.ng, bs.wi), bs.wi);
+        self.ray = Ray::new(offset_origin(s.position, s.ng, bs.wi), bs.wi);
         shadow
     }
 

@@ -133,11 +133,7 @@ fn sample_shape(
                     sin_theta * sin,
                     cos_theta,
                 ));
-                let ray = Ray {
-                    origin: p.into(),
-                    dir: dir.into(),
-                };
-                let mut t = intersect_sphere(a.into(), radius, &ray, 1e30);
+                let mut t = intersect_sphere(a.into(), radius, &Ray::new(p, dir), 1e30);
                 if t == MISS {
                     t = (a - p).dot(dir);
                 }
