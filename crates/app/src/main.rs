@@ -2,12 +2,12 @@
 
 #[macro_use]
 mod note;
-mod bench_cmd;
+mod backend;
+mod bench;
 mod cli;
 mod output;
 mod progress;
-mod render_cmd;
-mod setup;
+mod render;
 mod view;
 
 use std::process::ExitCode;
@@ -21,9 +21,9 @@ fn main() -> ExitCode {
     .init();
     let cli = cli::Cli::parse();
     let result = match cli.command {
-        Some(cli::Command::Render(args)) => render_cmd::run(&args),
+        Some(cli::Command::Render(args)) => render::run(&args),
         Some(cli::Command::View(args)) => view::run(&args),
-        Some(cli::Command::Bench(args)) => bench_cmd::run(&args),
+        Some(cli::Command::Bench(args)) => bench::run(&args),
         None => view::run(&cli::ViewArgs::defaults()),
     };
     match result {

@@ -4,8 +4,8 @@ use std::fs::OpenOptions;
 use std::path::Path;
 
 use anyhow::{Context, bail};
-use pathlight_core::texture::linear_to_srgb;
-use pathlight_render::Film;
+use pathlight_core::Film;
+use pathlight_scene::texture::linear_to_srgb;
 
 /// Image file formats pathlight writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

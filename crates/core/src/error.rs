@@ -1,46 +1,31 @@
-//! Errors raised while reading a scene and its assets.
+//! Errors of rendering, on either backend.
 
-use std::path::PathBuf;
-
-/// Everything that can go wrong between a scene file and a renderable [`crate::Scene`].
+/// What can fail between choosing a device and reading the image back.
 #[derive(Debug, thiserror::Error)]
-pub enum SceneError {
-    /// A file (scene, mesh or texture) could not be read.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file that could not be read.
-        path: PathBuf,
-        /// Why.
-        source: std::io::Error,
-    },
-    /// The scene file is not valid TOML or does not match the format (unknown key, wrong type).
-    #[error("{file}:{line}:{column}: {message}")]
-    Syntax {
-        /// The scene file.
-        file: String,
-        /// 1-based line.
-        line: usize,
-        /// 1-based column.
-        column: usize,
-        /// What the parser said, naming the key.
+pub enum RenderError {
+    /// No adapter at all, or none matching the requested name.
+    #[error("{0}")]
+    NoAdapter(String),
+    /// The adapter refused to create a device.
+    #[error("cannot open a device on {adapter}: {message}")]
+    Device {
+        /// The adapter's name.
+        adapter: String,
+        /// What wgpu said.
         message: String,
     },
-    /// A value is well-formed but not allowed (out of range, unknown material, ...).
-    #[error("{file}:{line}: {message}")]
-    Invalid {
-        /// The scene file.
-        file: String,
-        /// 1-based line of the entity holding the value.
-        line: usize,
-        /// What is wrong, naming the key and the value.
+    /// A shader or pipeline failed validation.
+    #[error("pipeline {label}: {message}")]
+    Pipeline {
+        /// The pipeline's label.
+        label: String,
+        /// What wgpu said.
         message: String,
     },
-    /// A referenced asset (mesh or texture) exists but could not be decoded.
-    #[error("{path}: {message}")]
-    Asset {
-        /// The asset file.
-        path: PathBuf,
-        /// What the decoder said.
-        message: String,
-    },
+    /// The scene or image does not fit the device's limits.
+    #[error("{0}")]
+    Limits(String),
+    /// The GPU failed while rendering or reading back.
+    #[error("GPU failure: {0}")]
+    Gpu(String),
 }

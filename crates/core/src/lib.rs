@@ -1,25 +1,25 @@
-//! pathlight's core: the scene description and its loading, the BVH, and the data laid out
-//! for the GPU. Nothing here depends on wgpu.
+//! pathlight's core: a [`Scene`](pathlight_scene::Scene) prepared once for rendering and
+//! shared by both backends ([`PreparedScene`]: the BVH and the buffers both read, laid out
+//! as WGSL declares them), the per-render constants (camera, settings), the film, and the
+//! interface both backends implement ([`Renderer`]). Nothing here depends on wgpu.
 
-pub mod accel;
-pub mod default_scene;
-pub mod desc;
+pub mod bvh;
+pub mod camera;
 pub mod error;
 pub mod film;
-pub mod frame;
-pub mod gpu;
-pub mod load;
-pub mod mesh;
-pub mod packet;
-pub mod revolve;
-pub mod scene;
-pub mod texture;
-pub mod trace;
-pub mod wide_bvh;
+pub mod geometry;
+pub mod gpu_types;
+pub mod light_table;
+pub mod params;
+pub mod prepared;
+pub mod renderer;
+pub mod shading;
+pub mod textures;
 
-pub use accel::GpuScene;
-pub use error::SceneError;
+pub use error::RenderError;
 pub use film::Film;
-pub use load::{SceneSource, load_scene, load_scene_file};
-pub use scene::{Camera, Material, Object, RenderSettings, Scene, Shape};
-pub use wide_bvh::{Tracer, WideBvh};
+pub use geometry::Geometry;
+pub use prepared::PreparedScene;
+pub use renderer::Renderer;
+pub use shading::Shading;
+pub use textures::Textures;

@@ -16,7 +16,7 @@
 use std::f32::consts::{FRAC_1_PI, PI};
 
 use glam::{Vec2, Vec3A};
-use pathlight_core::gpu::GpuMaterial;
+use pathlight_core::gpu_types::GpuMaterial;
 
 use crate::sampling::{Frame, sample_cosine_hemisphere, sin_cos_turns};
 use crate::surface::Surface;

@@ -2,15 +2,16 @@
 //! `integrator.wgsl` (same loop, same order of sample dimensions).
 
 use glam::Vec3A;
-use pathlight_core::Tracer;
-use pathlight_core::gpu::{GpuFrameParams, NO_LIGHT};
-use pathlight_core::trace::{Hit, Ray};
+use pathlight_core::gpu_types::{GpuRenderParams, NO_LIGHT};
 
 use crate::bsdf::{eval_bsdf, has_continuous_lobe, sample_bsdf};
+use crate::bvh::{Hit, Tracer};
+use crate::camera::camera_ray;
+use crate::cpu_scene::CpuScene;
+use crate::intersect::Ray;
 use crate::lights::{LightSample, env_pdf, light_pdf, sample_light};
 use crate::sampler::{Draw, Sampler};
 use crate::sampling::power_heuristic;
-use crate::scene::CpuScene;
 use crate::surface::{base_color, surface_at};
 
 /// Largest radiance one sample may add per channel (WGSL `SAMPLE_MAX`).
@@ -24,18 +25,6 @@ pub const T_MAX: f32 = 1.0e30;
 fn offset_origin(p: Vec3A, ng: Vec3A, dir: Vec3A) -> Vec3A {
     let eps = 1e-4 * (1.0 + p.abs().max_element());
     p + if dir.dot(ng) > 0.0 { ng } else { -ng } * eps
-}
-
-/// Camera ray through a jittered point of pixel (x, y). Twin of WGSL `camera_ray`.
-#[inline(always)]
-fn camera_ray(params: &GpuFrameParams, x: u32, y: u32, sampler: &mut Sampler) -> Ray {
-    let jitter = sampler.next_2d();
-    let ndc_x = 2.0 * (x as f32 + jitter.x) / params.width as f32 - 1.0;
-    let ndc_y = 1.0 - 2.0 * (y as f32 + jitter.y) / params.height as f32;
-    let dir = Vec3A::from(params.camera_forward)
-        + ndc_x * Vec3A::from(params.camera_right)
-        + ndc_y * Vec3A::from(params.camera_up);
-    Ray::new(params.camera_position, dir.normalize())
 }
 
 /// The shadow ray testing whether anything blocks the light sample `ls` from surface point
@@ -105,7 +94,7 @@ pub struct Path {
 impl Path {
     /// The path of sample `sampler` through pixel (x, y): its camera ray.
     #[inline(always)]
-    pub fn new(params: &GpuFrameParams, x: u32, y: u32, mut sampler: Sampler) -> Self {
+    pub fn new(params: &GpuRenderParams, x: u32, y: u32, mut sampler: Sampler) -> Self {
         let ray = camera_ray(params, x, y, &mut sampler);
         Self {
             ray,
@@ -132,7 +121,7 @@ impl Path {
     pub fn step(
         &mut self,
         scene: &CpuScene,
-        params: &GpuFrameParams,
+        params: &GpuRenderParams,
         hit: Option<Hit>,
     ) -> Option<ShadowTest> {
         self.depth += 1;
@@ -152,11 +141,11 @@ impl Path {
             return None;
         };
         let s = surface_at(scene, &hit, &ray);
-        let material = &scene.gpu.materials[s.material as usize];
+        let material = &scene.materials[s.material as usize];
         let wo = -Vec3A::from(ray.dir);
         let emission = Vec3A::from(material.emission);
         if wo.dot(s.ng) > 0.0 && emission.max_element() > 0.0 {
-            let object = &scene.gpu.objects[hit.object as usize];
+            let object = &scene.objects[hit.object as usize];
             let w = if self.prev_delta || object.light == NO_LIGHT {
                 1.0
             } else {
@@ -188,7 +177,7 @@ impl Path {
         ]);
         let (u_light_select, u_lobe, u_fresnel, u_rr) =
             (u_light_select.x, u_lobe.x, u_fresnel.x, u_rr.x);
-        let color = base_color(&scene.gpu, material, s.uv);
+        let color = base_color(scene, material, s.uv);
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
         let mut shadow = None;
         if has_continuous_lobe(material) {
@@ -245,7 +234,7 @@ impl Path {
 pub fn trace_path(
     tracer: &mut Tracer,
     scene: &CpuScene,
-    params: &GpuFrameParams,
+    params: &GpuRenderParams,
     x: u32,
     y: u32,
     sampler: Sampler,

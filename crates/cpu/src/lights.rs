@@ -9,15 +9,16 @@
 use std::f32::consts::{PI, TAU};
 
 use glam::{Vec2, Vec3A};
-use pathlight_core::gpu::{
-    FLAG_CAPS, GpuFrameParams, KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE,
+use pathlight_core::gpu_types::{
+    FLAG_CAPS, GpuObject, GpuRenderParams, KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE,
 };
-use pathlight_core::trace::{MISS, Ray, intersect_sphere};
+use pathlight_core::light_table;
 
+use crate::cpu_scene::CpuScene;
+use crate::intersect::{MISS, Ray, intersect_sphere};
 use crate::sampling::{
     Frame, sample_cosine_hemisphere, sample_disk, sample_uniform_sphere, sin_cos_turns,
 };
-use crate::scene::CpuScene;
 
 /// A sampled light direction. Twin of WGSL `LightSample`.
 #[derive(Debug, Clone, Copy)]
@@ -48,8 +49,19 @@ const INVALID: LightSample = LightSample {
 /// Density of choosing the environment and direction `wi` from a point with normal `n`
 /// (on the side light is gathered from). Twin of WGSL `env_pdf`.
 #[inline(always)]
-pub fn env_pdf(params: &GpuFrameParams, n: Vec3A, wi: Vec3A) -> f32 {
+pub fn env_pdf(params: &GpuRenderParams, n: Vec3A, wi: Vec3A) -> f32 {
     params.env_pmf * n.dot(wi).max(0.0) / PI
+}
+
+/// The area of light-table entry `(object, primitive)` (`o` is its object): the whole
+/// shape, or triangle `primitive` of a mesh. Twin of WGSL `emitter_area`.
+#[inline(always)]
+fn emitter_area(scene: &CpuScene, object: u32, o: &GpuObject, primitive: u32) -> f32 {
+    if o.kind == KIND_QUAD {
+        scene.quad_area(object)
+    } else {
+        light_table::emitter_area(o, scene.vertices, primitive)
+    }
 }
 
 /// `1 - cos` of the half-angle of the cone a sphere subtends from `p`, or a negative value
@@ -71,20 +83,20 @@ fn sphere_cone(center: Vec3A, radius: f32, p: Vec3A) -> f32 {
 #[inline(always)]
 pub fn light_pdf(
     scene: &CpuScene,
-    params: &GpuFrameParams,
+    params: &GpuRenderParams,
     object: u32,
     primitive: u32,
     p: Vec3A,
     p_light: Vec3A,
     n_light: Vec3A,
 ) -> f32 {
-    let o = &scene.gpu.objects[object as usize];
+    let o = &scene.objects[object as usize];
     let entry = if o.kind == KIND_MESH {
         o.light + primitive - o.first_triangle
     } else {
         o.light
     };
-    let pmf = scene.gpu.lights[entry as usize].pmf * (1.0 - params.env_pmf);
+    let pmf = scene.lights[entry as usize].pmf * (1.0 - params.env_pmf);
     let to_light = p_light - p;
     let d2 = to_light.length_squared();
     let cos_l = n_light.dot(-to_light).abs() / d2.sqrt();
@@ -94,7 +106,7 @@ pub fn light_pdf(
             return pmf / (TAU * one_minus_cos);
         }
     }
-    let area = scene.emitter_area(object, o, primitive);
+    let area = emitter_area(scene, object, o, primitive);
     if cos_l <= 0.0 || area <= 0.0 {
         return 0.0;
     }
@@ -113,13 +125,13 @@ fn sample_shape(
     u: Vec2,
     u_part: f32,
 ) -> (Vec3A, Vec3A, f32) {
-    let o = &scene.gpu.objects[object as usize];
+    let o = &scene.objects[object as usize];
     let [a, b, c] = [o.a, o.b, o.c].map(|v| Vec3A::from_slice(&v));
     match o.kind {
         KIND_QUAD => (
             a + u.x * b + u.y * c,
             scene.quad_normal(object),
-            1.0 / scene.emitter_area(object, o, primitive),
+            1.0 / emitter_area(scene, object, o, primitive),
         ),
         KIND_SPHERE => {
             let radius = o.a[3];
@@ -149,7 +161,7 @@ fn sample_shape(
             let height = axis_full.length();
             let axis = axis_full / height;
             let frame = Frame::around(axis);
-            let area = scene.emitter_area(object, o, primitive);
+            let area = emitter_area(scene, object, o, primitive);
             let side = TAU * radius * height;
             if u_part * area < side || o.flags & FLAG_CAPS == 0 {
                 let (sin, cos) = sin_cos_turns(u.x);
@@ -171,7 +183,7 @@ fn sample_shape(
             }
         }
         _ => {
-            let [v0, v1, v2] = scene.gpu.triangle(primitive).map(Vec3A::from);
+            let [v0, v1, v2] = scene.triangle(primitive).map(Vec3A::from);
             let su = u.x.sqrt();
             let (b1, b2) = (1.0 - su, u.y * su);
             let cross = (v1 - v0).cross(v2 - v0);
@@ -189,7 +201,7 @@ fn sample_shape(
 #[inline(always)]
 pub fn sample_light(
     cpu_scene: &CpuScene,
-    params: &GpuFrameParams,
+    params: &GpuRenderParams,
     p: Vec3A,
     n: Vec3A,
     u_select: f32,
@@ -211,7 +223,7 @@ pub fn sample_light(
     if params.light_count == 0 {
         return INVALID;
     }
-    let scene = &cpu_scene.gpu;
+    let scene = cpu_scene;
     let u_light = ((u_select - params.env_pmf) / (1.0 - params.env_pmf)).min(0.999_999_94);
     // First entry whose cumulative probability exceeds u_light.
     let (mut lo, mut hi) = (0u32, params.light_count - 1);

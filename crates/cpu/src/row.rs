@@ -4,18 +4,18 @@
 use std::ops::Range;
 
 use glam::Vec3A;
-use pathlight_core::Tracer;
-use pathlight_core::gpu::GpuFrameParams;
-use pathlight_core::packet::{PACKET, RayPacket};
+use pathlight_core::gpu_types::GpuRenderParams;
 
+use crate::bvh::Tracer;
+use crate::cpu_scene::CpuScene;
 use crate::integrator::{Path, T_MAX, accumulated_value};
+use crate::packet::{PACKET, RayPacket};
 use crate::sampler::Sampler;
-use crate::scene::CpuScene;
 
 /// One row's share of an `advance`.
 pub(crate) struct RowJob<'a> {
-    pub scene: &'a CpuScene,
-    pub params: &'a GpuFrameParams,
+    pub scene: &'a CpuScene<'a>,
+    pub params: &'a GpuRenderParams,
     /// The row.
     pub y: u32,
     /// Sample indices to add to every pixel.
@@ -122,7 +122,10 @@ pub enum InstructionSet {
 impl InstructionSet {
     /// Every level this CPU can run, baseline first.
     pub fn supported() -> Vec<Self> {
-        #[allow(unused_mut)]
+        #[cfg_attr(
+            not(target_arch = "x86_64"),
+            expect(unused_mut, reason = "only x86-64 has levels above the baseline")
+        )]
         let mut levels = vec![Self::Baseline];
         #[cfg(target_arch = "x86_64")]
         {

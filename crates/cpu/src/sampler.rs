@@ -8,7 +8,7 @@
 //! (pixel, sample, seed).
 
 use glam::Vec2;
-use pathlight_core::gpu::SAMPLER_SOBOL;
+use pathlight_core::gpu_types::SAMPLER_SOBOL;
 
 /// PCG hash (Jarzynski and Olano, JCGT 2020). Twin of WGSL `pcg_hash`.
 pub const fn pcg_hash(v: u32) -> u32 {
@@ -209,7 +209,7 @@ impl Sampler {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use pathlight_core::gpu::SAMPLER_INDEPENDENT;
+    use pathlight_core::gpu_types::SAMPLER_INDEPENDENT;
 
     /// Sobol dimension 0 (van der Corput).
     fn sobol_0(index: u32) -> u32 {

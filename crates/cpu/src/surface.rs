@@ -3,14 +3,14 @@
 use std::f32::consts::{PI, TAU};
 
 use glam::{Vec2, Vec3A};
-use pathlight_core::GpuScene;
-use pathlight_core::gpu::{
+use pathlight_core::gpu_types::{
     FLAG_CAPS, FLAG_FLAT, GpuMaterial, GpuTextureInfo, KIND_CYLINDER, KIND_QUAD, KIND_SPHERE,
 };
-use pathlight_core::trace::{Hit, Ray};
 
+use crate::bvh::Hit;
+use crate::cpu_scene::CpuScene;
+use crate::intersect::Ray;
 use crate::sampling::Frame;
-use crate::scene::CpuScene;
 
 /// The surface at a hit. Twin of WGSL `Surface`.
 #[derive(Debug, Clone, Copy)]
@@ -37,14 +37,14 @@ fn srgb_to_linear(c: f32) -> f32 {
 }
 
 /// Twin of WGSL `texel`.
-fn texel(scene: &GpuScene, info: &GpuTextureInfo, x: u32, y: u32) -> Vec3A {
+fn texel(scene: &CpuScene, info: &GpuTextureInfo, x: u32, y: u32) -> Vec3A {
     let packed = scene.texels[(info.offset + y * info.width + x) as usize];
     let [r, g, b, _] = packed.to_le_bytes();
     Vec3A::new(r as f32, g as f32, b as f32).map(|c| srgb_to_linear(c / 255.0))
 }
 
 /// Bilinear lookup, u wraps, v clamps. Twin of WGSL `sample_texture`.
-fn sample_texture(scene: &GpuScene, index: u32, uv: Vec2) -> Vec3A {
+fn sample_texture(scene: &CpuScene, index: u32, uv: Vec2) -> Vec3A {
     let info = &scene.textures[index as usize];
     let size = Vec2::new(info.width as f32, info.height as f32);
     let p = Vec2::new(uv.x - uv.x.floor(), uv.y.clamp(0.0, 1.0)) * size - 0.5;
@@ -61,7 +61,7 @@ fn sample_texture(scene: &GpuScene, index: u32, uv: Vec2) -> Vec3A {
 
 /// The material's colour at `uv`. Twin of WGSL `base_color`.
 #[inline(always)]
-pub fn base_color(scene: &GpuScene, material: &GpuMaterial, uv: Vec2) -> Vec3A {
+pub fn base_color(scene: &CpuScene, material: &GpuMaterial, uv: Vec2) -> Vec3A {
     if material.texture >= 0 {
         sample_texture(scene, material.texture as u32, uv)
     } else {
@@ -74,7 +74,7 @@ pub fn base_color(scene: &GpuScene, material: &GpuMaterial, uv: Vec2) -> Vec3A {
 /// otherwise).
 #[inline(always)]
 pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
-    let scene = &cpu_scene.gpu;
+    let scene = cpu_scene;
     let o = &scene.objects[hit.object as usize];
     let textured = scene.materials[o.material as usize].texture >= 0;
     let [a, b] = [o.a, o.b].map(|v| Vec3A::from_slice(&v));

@@ -6,7 +6,7 @@
 use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3A};
-use pathlight_core::gpu::GpuMaterial;
+use pathlight_core::gpu_types::GpuMaterial;
 use pathlight_cpu::bsdf::{eval_bsdf, fresnel_conductor, fresnel_dielectric, ggx_d, sample_bsdf};
 use pathlight_cpu::sampling::sample_uniform_sphere;
 use pathlight_cpu::surface::Surface;

@@ -9,12 +9,12 @@
 
 use std::path::{Path, PathBuf};
 
-use pathlight_core::frame::frame_params;
-use pathlight_core::{Film, GpuScene, Tracer, WideBvh, load_scene_file};
+use pathlight_core::gpu_types::GpuRenderParams;
+use pathlight_core::{Film, PreparedScene, Renderer};
 use pathlight_cpu::integrator::{accumulated_value, trace_path};
 use pathlight_cpu::sampler::Sampler;
-use pathlight_cpu::scene::CpuScene;
-use pathlight_cpu::{CpuRenderer, InstructionSet};
+use pathlight_cpu::{CpuRenderer, CpuScene, InstructionSet, Tracer};
+use pathlight_scene::{Scene, load_scene_file};
 
 /// Mitsuba 3.9.1's own relMSE at 128x128, 64 spp, llvm_ad_rgb, mean over seeds 0-7, from
 /// `python tools/mitsuba_refs.py relmse NAME --res 128 --spp 64 --seeds 8`.
@@ -37,11 +37,18 @@ fn render(name: &str, size: u32, spp: u32) -> Film {
     scene.camera.width = size;
     scene.camera.height = size;
     scene.settings.spp = spp;
-    let mut renderer = CpuRenderer::new(&scene, GpuScene::build(&scene));
+    render_scene(&scene, spp, InstructionSet::best())
+}
+
+/// Renders `scene` on the CPU at `spp` with the path tracer compiled for `isa`.
+fn render_scene(scene: &Scene, spp: u32, isa: InstructionSet) -> Film {
+    let prepared = PreparedScene::new(scene);
+    let mut renderer = CpuRenderer::new(&prepared, &scene.camera, &scene.settings);
+    renderer.set_instruction_set(isa).unwrap();
     while renderer.samples_done() < spp {
-        renderer.advance(spp - renderer.samples_done());
+        renderer.advance(spp - renderer.samples_done()).unwrap();
     }
-    renderer.film()
+    renderer.film().unwrap()
 }
 
 /// Renders NAME at 128x128, 64 spp, checks both bars and returns the image.
@@ -140,14 +147,7 @@ fn every_instruction_set_renders_the_same_image() {
     scene.camera.height = 32;
     let images: Vec<(InstructionSet, Film)> = InstructionSet::supported()
         .into_iter()
-        .map(|isa| {
-            let mut renderer = CpuRenderer::new(&scene, GpuScene::build(&scene));
-            renderer.set_instruction_set(isa).unwrap();
-            while renderer.samples_done() < 4 {
-                renderer.advance(4 - renderer.samples_done());
-            }
-            (isa, renderer.film())
-        })
+        .map(|isa| (isa, render_scene(&scene, 4, isa)))
         .collect();
     let (_, baseline) = &images[0];
     assert!(
@@ -173,16 +173,11 @@ fn packets_trace_each_path_as_it_is_traced_alone() {
     let (size, spp) = (48, 4);
     scene.camera.width = size;
     scene.camera.height = size;
-    let gpu_scene = GpuScene::build(&scene);
-    let mut renderer = CpuRenderer::new(&scene, gpu_scene.clone());
-    while renderer.samples_done() < spp {
-        renderer.advance(spp - renderer.samples_done());
-    }
-    let film = renderer.film();
-    let params = frame_params(&scene, &gpu_scene);
-    let bvh = WideBvh::build(&gpu_scene);
-    let mut tracer = Tracer::new(&gpu_scene, &bvh);
-    let cpu_scene = CpuScene::new(gpu_scene.clone());
+    let film = render_scene(&scene, spp, InstructionSet::best());
+    let prepared = PreparedScene::new(&scene);
+    let params = GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
+    let cpu_scene = CpuScene::new(&prepared);
+    let mut tracer = Tracer::new(&cpu_scene);
     let mut differing = 0;
     for y in 0..size {
         for x in 0..size {

@@ -7,6 +7,10 @@
 // visible-normal sampling (Heitz 2018). `eval_bsdf` returns f * |cos_i| of the non-delta
 // lobes and the density of `sample_bsdf` producing wi.
 
+#import scene
+#import surface
+#import sampling
+
 const ALPHA_MIN: f32 = 1e-3;
 
 struct BsdfEval {

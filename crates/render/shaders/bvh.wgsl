@@ -1,24 +1,29 @@
 // 4-wide BVH traversal over every primitive of the scene (`nodes`: `WideNode`s collapsed
-// from an obvhs BVH2, `crates/core/src/wide_bvh.rs`; leaves index `primitives`: shapes and
+// from an obvhs BVH2, `crates/core/src/bvh.rs`; leaves index `primitives`: shapes and
 // the triangles of every mesh). Ordered depth-first with one explicit stack. At each node the
 // four child boxes are tested at once. The entered leaves that hold shapes (SHAPE_LEAF) are
 // tested at once; the other entered children (inner nodes, leaves of triangles as LEAF
 // entries) are sorted, the nearest is taken next and the others are pushed with their entry
 // distances, nearest on top, to be skipped on pop if a closer hit was found meanwhile.
 // Leaves of triangles are tested in a loop of their own. Shadow rays stop at the first hit.
-// CPU twin: `Walk::tree` in `crates/core/src/wide_bvh.rs` (which tests a node's leaves as it
-// visits the node; the hits are the same).
+// CPU twin: `crates/cpu/src/bvh.rs` (whose walk tests a node's leaves as it visits the node;
+// the hits are the same).
 //
 // `ACCEL` (a pipeline constant) selects the seed's slower schemes for benchmarks: every object
 // in turn, a mesh's triangles tested only when the ray hits the mesh's bounding box
 // (ACCEL_BOUNDING_VOLUME) or always (ACCEL_BRUTE_FORCE). Each finds the same nearest hit.
+
+#import scene
+#import intersect
 
 const ACCEL_BVH: u32 = 0u;
 const ACCEL_BOUNDING_VOLUME: u32 = 1u;
 const ACCEL_BRUTE_FORCE: u32 = 2u;
 override ACCEL: u32 = 0u;
 
-const STACK_SIZE: u32 = 64u;
+// Entries of the traversal stack: the host sizes it to the scene's tree
+// (`pathlight_core::bvh::stack_bound`, rounded up to 8) when it assembles the module.
+#const STACK_SIZE: u32
 const NO_HIT: u32 = 0xffffffffu;
 // Stack entry tag (an untagged entry is an inner node): a leaf child, node << 2 | lane in
 // the low bits (the host refuses trees of 2^28 nodes or more).

@@ -6,27 +6,14 @@
 // Mitsuba). Non-finite samples are dropped (counted as zero), so no NaN or Inf reaches
 // the film. CPU twin: `crates/cpu/src/integrator.rs`.
 
-// Per-batch constants. Host: `GpuFrameParams`.
-struct FrameParams {
-    camera_position: vec3f,
-    width: u32,
-    camera_forward: vec3f,
-    height: u32,
-    camera_right: vec3f,
-    sample_offset: u32,
-    camera_up: vec3f,
-    batch_samples: u32,
-    environment: vec3f,
-    max_depth: u32,
-    rr_depth: u32,
-    seed: u32,
-    object_count: u32,
-    row_offset: u32,
-    light_count: u32,
-    env_pmf: f32,
-    sampler: u32,
-    row_end: u32,
-}
+#import params
+#import scene
+#import bvh
+#import sampler
+#import camera
+#import surface
+#import bsdf
+#import lights
 
 // Running sum of samples per channel as a 64-bit fixed-point number hi + lo / 2^32.
 // Integer adds are exact and cannot be reassociated by a shader compiler (a Kahan sum
@@ -61,7 +48,6 @@ fn add_fixed(acc: ptr<function, AccumPixel>, x: AccumPixel) {
     (*acc).lo = select(lo, vec4u(0xffffffffu), overflow);
 }
 
-@group(1) @binding(0) var<uniform> params: FrameParams;
 @group(1) @binding(1) var<storage, read_write> accum: array<AccumPixel>;
 // Rays traced since the counter was cleared, as a 64-bit count: [low word, high word].
 @group(1) @binding(2) var<storage, read_write> ray_counter: array<atomic<u32>, 2>;
@@ -77,16 +63,6 @@ const T_MAX: f32 = 1.0e30;
 fn offset_origin(p: vec3f, ng: vec3f, dir: vec3f) -> vec3f {
     let eps = 1e-4 * (1.0 + max(max(abs(p.x), abs(p.y)), abs(p.z)));
     return p + select(-ng, ng, dot(dir, ng) > 0.0) * eps;
-}
-
-fn camera_ray(x: u32, y: u32, sampler: ptr<function, Sampler>) -> Ray {
-    let jitter = next_2d(sampler);
-    let ndc = vec2f(
-        2.0 * (f32(x) + jitter.x) / f32(params.width) - 1.0,
-        1.0 - 2.0 * (f32(y) + jitter.y) / f32(params.height),
-    );
-    let dir = params.camera_forward + ndc.x * params.camera_right + ndc.y * params.camera_up;
-    return Ray(params.camera_position, normalize(dir));
 }
 
 // The shadow ray testing light sample `ls` from surface point p (normal ng): from the offset

@@ -1,5 +1,5 @@
 // Ray-primitive intersection: boxes, quads, spheres, cylinders, triangles.
-// CPU twin: `crates/core/src/trace.rs` (same names, same arithmetic).
+// CPU twin: `crates/cpu/src/intersect.rs` (same names, same arithmetic).
 // Each function returns the hit distance, or MISS when there is none in (0, t_max).
 
 const MISS: f32 = 3.0e38;

@@ -4,6 +4,11 @@
 // power from `lights`. Quads,
 // cylinders and triangles are sampled by area, spheres by solid angle from outside.
 
+#import scene
+#import params
+#import intersect
+#import sampling
+
 struct LightSample {
     wi: vec3f,
     // The point on the light (unused for the environment).
@@ -26,7 +31,8 @@ fn env_pdf(n: vec3f, wi: vec3f) -> f32 {
 }
 
 // Surface area of light-table entry (o, primitive): the whole shape, or one triangle of a
-// mesh. Host twin: `GpuScene::emitter_area` (which also weighs the table by it).
+// mesh. The host computes the same areas to weigh the light table by power
+// (`crates/core/src/light_table.rs`).
 fn emitter_area(o: Object, primitive: u32) -> f32 {
     switch o.kind {
         case KIND_QUAD: {

@@ -1,6 +1,6 @@
 // Scene data shared by every pass: struct declarations (mirrored on the host by
-// `crates/core/src/gpu.rs`, pinned by `crates/render/tests/layout.rs`) and the bind group 0
-// buffers that `GpuScene` fills.
+// `crates/core/src/gpu_types.rs`, pinned by `crates/render/tests/shaders.rs`) and the bind
+// group 0 buffers that `pathlight_core::PreparedScene` fills.
 
 const KIND_QUAD: u32 = 0u;
 const KIND_SPHERE: u32 = 1u;

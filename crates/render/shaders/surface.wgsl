@@ -1,4 +1,10 @@
 // From a hit to the local surface: position, normals, texture coordinates, base colour.
+// CPU twin: `crates/cpu/src/surface.rs`.
+
+#import scene
+#import intersect
+#import bvh
+#import sampling
 
 struct Surface {
     position: vec3f,

@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use wgpu::{Adapter, AdapterInfo, Backend, DeviceType};
 
-use crate::error::RenderError;
+use pathlight_core::RenderError;
 
 /// An open device with its queue and the adapter it runs on (clones share the device).
 #[derive(Debug, Clone)]

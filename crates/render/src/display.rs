@@ -1,10 +1,11 @@
 //! The viewer's display pass (`shaders/display.wgsl`): shows the linear accumulation on a
 //! surface through the sRGB curve and an optional tone mapper, leaving it unchanged.
 
-use crate::error::RenderError;
-use crate::renderer::ProgressiveRenderer;
-use crate::scene_buffers::bind_buffers;
-use crate::shaders;
+use pathlight_core::{RenderError, Renderer};
+
+use crate::gpu_renderer::GpuRenderer;
+use crate::pipeline::bind_buffers;
+use crate::wgsl;
 
 /// How radiance is mapped to the display's [0, 1].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -84,7 +85,14 @@ impl DisplayPass {
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("display"),
-            source: wgpu::ShaderSource::Wgsl(shaders::DISPLAY.into()),
+            source: wgpu::ShaderSource::Wgsl(
+                wgsl::assemble("display", &[])
+                    .map_err(|err| RenderError::Pipeline {
+                        label: "display".into(),
+                        message: err.to_string(),
+                    })?
+                    .into(),
+            ),
         });
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
@@ -152,7 +160,7 @@ impl DisplayPass {
     /// Draws `renderer`'s current image, scaled to fill `target` (`target_size` pixels).
     pub fn draw(
         &self,
-        renderer: &ProgressiveRenderer,
+        renderer: &GpuRenderer,
         target: &wgpu::TextureView,
         target_size: (u32, u32),
         tonemap: ToneMap,

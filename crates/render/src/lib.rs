@@ -1,13 +1,13 @@
-//! pathlight's GPU side: adapter choice, the WGSL integrator and the progressive film.
+//! pathlight's GPU backend: adapter choice ([`context`]), the WGSL integrator assembled from
+//! `shaders/` ([`wgsl`]), the scene on the device ([`scene_buffers`]), the progressive
+//! renderer ([`GpuRenderer`]) and the viewer's display pass ([`display`]).
 
 pub mod context;
 pub mod display;
-pub mod error;
-pub mod renderer;
+pub mod gpu_renderer;
+pub mod pipeline;
 pub mod scene_buffers;
-pub mod shaders;
+pub mod wgsl;
 
 pub use context::GpuContext;
-pub use error::RenderError;
-pub use pathlight_core::Film;
-pub use renderer::{Accel, ProgressiveRenderer};
+pub use gpu_renderer::{Accel, GpuRenderer};

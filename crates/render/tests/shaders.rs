@@ -1,16 +1,17 @@
-//! Shaders without a device: every WGSL file is validated by naga as part of the modules it
-//! is assembled into, and every host struct shared with WGSL matches its declaration in size
-//! and field offsets.
+//! Shaders without a device: the modules assemble (every file under `shaders/` is one the
+//! assembler knows, and `build.rs` has validated each), the assembler's directives behave,
+//! and every host struct shared with WGSL matches its declaration in size and field
+//! offsets.
 
 use std::mem::{offset_of, size_of};
 
 use naga::valid::{Capabilities, ValidationFlags, Validator};
-use pathlight_core::gpu::{
-    GpuAccumPixel, GpuBvhNode, GpuFrameParams, GpuLight, GpuMaterial, GpuObject, GpuPrimitive,
+use pathlight_core::gpu_types::{
+    GpuAccumPixel, GpuCamera, GpuLight, GpuMaterial, GpuObject, GpuPrimitive, GpuRenderParams,
     GpuTextureInfo, GpuVertex, GpuWideNode,
 };
 use pathlight_render::display::GpuDisplayParams;
-use pathlight_render::shaders;
+use pathlight_render::wgsl::{self, AssemblyError};
 
 fn parse_and_validate(label: &str, source: &str) -> naga::Module {
     let module = naga::front::wgsl::parse_str(source)
@@ -21,26 +22,50 @@ fn parse_and_validate(label: &str, source: &str) -> naga::Module {
     module
 }
 
+/// The module `name` assembled with the default constants, parsed and validated.
+fn module(name: &str) -> naga::Module {
+    let source = wgsl::assemble(name, &wgsl::DEFAULT_CONSTANTS).unwrap();
+    parse_and_validate(name, &source)
+}
+
 #[test]
-fn every_wgsl_file_validates_within_its_modules() {
-    let integrator = shaders::integrator_module();
-    parse_and_validate("integrator module", &integrator);
-    parse_and_validate("ray query library", &shaders::ray_query_library());
-    for (name, source) in shaders::FILES {
-        assert!(
-            integrator.contains(source),
-            "{name} is not part of the integrator module"
-        );
+fn every_file_under_shaders_is_known_to_the_assembler() {
+    let mut on_disk: Vec<String> =
+        std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+    on_disk.sort();
+    let mut known: Vec<String> = wgsl::FILES
+        .iter()
+        .map(|(n, _)| format!("{n}.wgsl"))
+        .collect();
+    known.sort();
+    assert_eq!(on_disk, known);
+    for name in wgsl::MODULES {
+        module(name);
     }
-    parse_and_validate("display module", shaders::DISPLAY);
-    let on_disk = std::fs::read_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders"))
-        .unwrap()
-        .count();
+}
+
+#[test]
+fn the_assembler_includes_each_import_once_and_refuses_bad_directives() {
+    // `integrator` reaches `scene` through several files: it is included once.
+    let integrator = wgsl::assemble("integrator", &[("STACK_SIZE", 24)]).unwrap();
+    assert_eq!(integrator.matches("struct Object {").count(), 1);
+    assert!(integrator.contains("const STACK_SIZE: u32 = 24u;"));
+    assert!(!integrator.contains("#import") && !integrator.contains("#const"));
     assert_eq!(
-        on_disk,
-        shaders::FILES.len() + 1,
-        "a file under shaders/ is neither in shaders::FILES nor the display module"
+        wgsl::assemble("integrator", &[]),
+        Err(AssemblyError::MissingConstant("STACK_SIZE".into()))
     );
+    assert!(matches!(
+        wgsl::assemble_source("#import nowhere\n", &[]),
+        Err(AssemblyError::UnknownImport { .. })
+    ));
+    assert!(matches!(
+        wgsl::assemble_source("#define X 1\n", &[]),
+        Err(AssemblyError::BadDirective { line: 1, .. })
+    ));
 }
 
 /// Size and `(name, offset)` of every member of WGSL struct `name`.
@@ -77,8 +102,8 @@ macro_rules! assert_layout {
 
 #[test]
 fn host_structs_match_their_wgsl_declarations() {
-    let module = parse_and_validate("integrator module", &shaders::integrator_module());
-    let m = &module;
+    let integrator = module("integrator");
+    let m = &integrator;
     assert_layout!(
         m,
         "Object",
@@ -132,32 +157,35 @@ fn host_structs_match_their_wgsl_declarations() {
     assert_layout!(m, "TextureInfo", GpuTextureInfo, [offset, width, height]);
     assert_layout!(
         m,
-        "FrameParams",
-        GpuFrameParams,
+        "CameraParams",
+        GpuCamera,
+        [position, pad0, forward, pad1, right, pad2, up, pad3]
+    );
+    assert_layout!(
+        m,
+        "RenderParams",
+        GpuRenderParams,
         [
-            camera_position,
-            width,
-            camera_forward,
-            height,
-            camera_right,
-            sample_offset,
-            camera_up,
-            batch_samples,
+            camera,
             environment,
+            env_pmf,
+            width,
+            height,
+            sample_offset,
+            batch_samples,
+            row_offset,
+            row_end,
             max_depth,
             rr_depth,
             seed,
-            object_count,
-            row_offset,
-            light_count,
-            env_pmf,
             sampler,
-            row_end
+            object_count,
+            light_count
         ]
     );
     assert_layout!(m, "AccumPixel", GpuAccumPixel, [hi, lo]);
 
-    let display = parse_and_validate("display module", shaders::DISPLAY);
+    let display = module("display");
     let d = &display;
     assert_layout!(d, "DisplayPixel", GpuAccumPixel, [hi, lo]);
     assert_layout!(
@@ -174,14 +202,5 @@ fn host_structs_match_their_wgsl_declarations() {
             tonemap,
             encode_srgb
         ]
-    );
-}
-
-#[test]
-fn obvhs_nodes_have_the_gpu_node_layout() {
-    // GpuBvhNode copies obvhs' Bvh2Node field by field; the two must stay the same size.
-    assert_eq!(
-        size_of::<obvhs::bvh2::node::Bvh2Node>(),
-        size_of::<GpuBvhNode>()
     );
 }

@@ -2,7 +2,7 @@
 //! the scene's [`Camera`].
 
 use glam::Vec3;
-use pathlight_core::Camera;
+use pathlight_scene::Camera;
 
 /// Radians of orbit per pixel dragged.
 const ORBIT_PER_PIXEL: f32 = 0.005;

@@ -1,31 +1,26 @@
-//! Click-to-light (SPEC S5): the object under the cursor, found by the renderer's own
-//! intersection code (the CPU twin of the WGSL traversal, on the same BVH), and turning it
-//! into a light and back.
+//! Click-to-light: the object under the cursor, found by the renderer's own code (the CPU
+//! twins of the WGSL camera ray and traversal, on the same BVH), and turning it into a
+//! light and back.
 
 use std::collections::HashMap;
 
-use glam::Vec3;
-use pathlight_core::frame::frame_params;
-use pathlight_core::trace::Ray;
-use pathlight_core::{GpuScene, Scene};
+use glam::{Vec2, Vec3};
+use pathlight_core::PreparedScene;
+use pathlight_core::gpu_types::GpuRenderParams;
+use pathlight_cpu::camera::primary_ray;
+use pathlight_cpu::{CpuScene, Tracer};
+use pathlight_scene::Scene;
 
 /// Emission strength when the scene has no emitter to compare with.
 const FALLBACK_STRENGTH: f32 = 10.0;
 
-/// Index into `scene.objects` of the nearest object under image point (x, y) (pixels from
-/// the top-left corner, fractions allowed), if any.
-pub fn pick(scene: &Scene, gpu_scene: &GpuScene, x: f32, y: f32) -> Option<usize> {
-    let p = frame_params(scene, gpu_scene);
-    let ndc_x = 2.0 * x / p.width as f32 - 1.0;
-    let ndc_y = 1.0 - 2.0 * y / p.height as f32;
-    let dir = Vec3::from(p.camera_forward)
-        + ndc_x * Vec3::from(p.camera_right)
-        + ndc_y * Vec3::from(p.camera_up);
-    let ray = Ray {
-        origin: p.camera_position.into(),
-        dir: dir.normalize(),
-    };
-    let hit = gpu_scene.intersect(&ray, 1e30)?;
+/// Index into `scene.objects` of the nearest object of `prepared` (the scene prepared)
+/// under image point (x, y) (pixels from the top-left corner, fractions allowed), if any.
+pub fn pick(scene: &Scene, prepared: &PreparedScene, x: f32, y: f32) -> Option<usize> {
+    let params = GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
+    let ray = primary_ray(&params, Vec2::new(x, y));
+    let view = CpuScene::new(prepared);
+    let hit = Tracer::new(&view).intersect(&ray, 1e30)?;
     Some(hit.object as usize)
 }
 
@@ -90,42 +85,42 @@ impl LightSwitch {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use pathlight_core::default_scene;
+    use pathlight_scene::default_scene;
 
     fn index_of(scene: &Scene, name: &str) -> usize {
         scene.objects.iter().position(|o| o.name == name).unwrap()
     }
 
     /// The image point where the camera sees `p`.
-    fn project(scene: &Scene, gpu: &GpuScene, p: Vec3) -> (f32, f32) {
-        let f = frame_params(scene, gpu);
-        let d = p - Vec3::from(f.camera_position);
-        let forward = Vec3::from(f.camera_forward);
-        let (right, up) = (Vec3::from(f.camera_right), Vec3::from(f.camera_up));
+    fn project(scene: &Scene, p: Vec3) -> (f32, f32) {
+        let c = pathlight_core::gpu_types::GpuCamera::new(&scene.camera);
+        let d = p - Vec3::from(c.position);
+        let forward = Vec3::from(c.forward);
+        let (right, up) = (Vec3::from(c.right), Vec3::from(c.up));
         let d = d / d.dot(forward);
         let ndc_x = (d - forward).dot(right) / right.length_squared();
         let ndc_y = (d - forward).dot(up) / up.length_squared();
         (
-            (ndc_x + 1.0) * 0.5 * f.width as f32,
-            (1.0 - ndc_y) * 0.5 * f.height as f32,
+            (ndc_x + 1.0) * 0.5 * scene.camera.width as f32,
+            (1.0 - ndc_y) * 0.5 * scene.camera.height as f32,
         )
     }
 
     #[test]
     fn picks_the_nearest_object_under_the_point() {
         let scene = default_scene::load().unwrap();
-        let gpu = GpuScene::build(&scene);
+        let prepared = PreparedScene::new(&scene);
         for (name, centre) in [
             ("gold sphere", Vec3::new(0.2, 0.6, -2.4)),
             ("earth", Vec3::new(-1.2, 0.5, -2.05)),
             ("glass sphere", Vec3::new(0.5, 0.33, -1.05)),
         ] {
-            let (x, y) = project(&scene, &gpu, centre);
-            let picked = pick(&scene, &gpu, x, y).map(|i| scene.objects[i].name.clone());
+            let (x, y) = project(&scene, centre);
+            let picked = pick(&scene, &prepared, x, y).map(|i| scene.objects[i].name.clone());
             assert_eq!(picked.as_deref(), Some(name), "at ({x}, {y})");
         }
         // The top-left corner sees the ceiling or a wall, never a model.
-        let corner = pick(&scene, &gpu, 0.5, 0.5).map(|i| scene.objects[i].name.clone());
+        let corner = pick(&scene, &prepared, 0.5, 0.5).map(|i| scene.objects[i].name.clone());
         assert!(
             corner
                 .as_ref()
@@ -153,7 +148,9 @@ mod tests {
             lit.lobes,
             own.materials[own.objects[vase].material as usize].lobes
         );
-        assert!(GpuScene::build(&scene).light_count > GpuScene::build(&own).light_count);
+        let prepared = PreparedScene::new(&own);
+        let lights = |s: &Scene| prepared.shading_of(s).light_count;
+        assert!(lights(&scene) > lights(&own));
         assert!(
             !switch.toggle(&mut scene, vase),
             "a second click turns it off"

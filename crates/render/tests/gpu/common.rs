@@ -3,8 +3,9 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use pathlight_core::{GpuScene, Scene, load_scene_file};
-use pathlight_render::{Film, GpuContext, ProgressiveRenderer};
+use pathlight_core::{Film, PreparedScene, Renderer};
+use pathlight_render::{Accel, GpuContext, GpuRenderer};
+use pathlight_scene::{Scene, load_scene_file};
 
 /// The device every test of this binary shares (the software adapter on CI).
 pub fn context() -> &'static GpuContext {
@@ -29,14 +30,35 @@ pub fn scene(relative: &str, size: u32, spp: u32, seed: u32) -> Scene {
     scene
 }
 
-/// Renders `scene` to its full spp.
-pub fn render(scene: &Scene) -> Film {
-    let gpu_scene = GpuScene::build(scene);
-    let mut renderer = ProgressiveRenderer::new(context(), scene, &gpu_scene).unwrap();
-    while renderer.samples_done() < scene.settings.spp {
-        renderer
-            .advance(scene.settings.spp - renderer.samples_done())
-            .unwrap();
+/// A GPU renderer of `scene` (prepared here) finding hits with the BVH.
+pub fn gpu_renderer(scene: &Scene) -> GpuRenderer {
+    let prepared = PreparedScene::new(scene);
+    GpuRenderer::new(
+        context(),
+        &prepared,
+        &scene.camera,
+        &scene.settings,
+        Accel::Bvh,
+    )
+    .unwrap()
+}
+
+/// Renders with `renderer` to `spp` samples per pixel.
+pub fn render_to(renderer: &mut dyn Renderer, spp: u32) -> Film {
+    while renderer.samples_done() < spp {
+        renderer.advance(spp - renderer.samples_done()).unwrap();
     }
-    renderer.read_film().unwrap()
+    renderer.film().unwrap()
+}
+
+/// Renders `scene` to its full spp on the GPU.
+pub fn render(scene: &Scene) -> Film {
+    render_to(&mut gpu_renderer(scene), scene.settings.spp)
+}
+
+/// Renders `scene` to its full spp on the CPU backend.
+pub fn render_cpu(scene: &Scene) -> Film {
+    let prepared = PreparedScene::new(scene);
+    let mut renderer = pathlight_cpu::CpuRenderer::new(&prepared, &scene.camera, &scene.settings);
+    render_to(&mut renderer, scene.settings.spp)
 }

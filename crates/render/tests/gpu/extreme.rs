@@ -4,13 +4,14 @@
 //! the CPU twin are checked one by one (the film drops non-finite samples, so checking it
 //! alone would prove nothing); the GPU, the same code, must then agree with it.
 
-use pathlight_core::{GpuScene, SceneSource, load_scene};
-use pathlight_cpu::CpuRenderer;
+use pathlight_core::PreparedScene;
+use pathlight_core::gpu_types::GpuRenderParams;
 use pathlight_cpu::integrator::trace_path;
 use pathlight_cpu::sampler::Sampler;
-use pathlight_cpu::scene::CpuScene;
+use pathlight_cpu::{CpuScene, Tracer};
+use pathlight_scene::{SceneSource, load_scene};
 
-use crate::common::render;
+use crate::common::{render, render_cpu};
 
 const SCENE: &str = r#"
 color_space = "linear"
@@ -98,11 +99,10 @@ fn extreme_values_give_finite_samples_on_both_backends() {
     // The camera looks along the floor plane: y = 0 exactly.
     s.camera.position.y = 0.0;
     s.camera.look_at.y = 0.0;
-    let gpu_scene = GpuScene::build(&s);
-    let params = pathlight_core::frame::frame_params(&s, &gpu_scene);
-    let bvh = pathlight_core::WideBvh::build(&gpu_scene);
-    let mut tracer = pathlight_core::Tracer::new(&gpu_scene, &bvh);
-    let cpu_scene = CpuScene::new(gpu_scene.clone());
+    let prepared = PreparedScene::new(&s);
+    let params = GpuRenderParams::new(&s.camera, &s.settings, &prepared.shading);
+    let cpu_scene = CpuScene::new(&prepared);
+    let mut tracer = Tracer::new(&cpu_scene);
     let mut nonzero = 0;
     for y in 0..32 {
         for x in 0..32 {
@@ -121,13 +121,10 @@ fn extreme_values_give_finite_samples_on_both_backends() {
         nonzero > 8000,
         "the scene is lit: {nonzero} of 16384 samples carry light"
     );
-    let mut cpu = CpuRenderer::new(&s, gpu_scene);
-    while cpu.samples_done() < 16 {
-        cpu.advance(16 - cpu.samples_done());
-    }
+    let cpu = render_cpu(&s);
     let gpu = render(&s);
     assert!(gpu.pixels.iter().flatten().all(|c| c.is_finite()));
-    let (g, c) = (gpu.mean(), cpu.film().mean());
+    let (g, c) = (gpu.mean(), cpu.mean());
     for i in 0..3 {
         assert!(
             (g[i] - c[i]).abs() <= 0.01 * c[i],

@@ -4,9 +4,10 @@
 
 use pathlight_core::Film;
 
-use crate::common::{context, render, repo, scene};
+use crate::common::{context, gpu_renderer, render, render_to, repo, scene};
 use glam::Vec3;
-use pathlight_core::default_scene;
+use pathlight_core::{PreparedScene, Renderer};
+use pathlight_scene::default_scene;
 
 /// Pixel coordinates `(x, y)`.
 type Pixels = Vec<(u32, u32)>;
@@ -133,7 +134,7 @@ fn cornell_diffuse_matches_mitsuba() {
 }
 
 /// An 8x8 camera seeing only a constant environment of 0.1, at `spp`.
-fn constant_environment(spp: u32) -> pathlight_core::Scene {
+fn constant_environment(spp: u32) -> pathlight_scene::Scene {
     let mut s = scene("refs/furnace-1.0.toml", 8, spp, 0);
     s.objects.clear();
     s.environment = Vec3::splat(0.1);
@@ -163,13 +164,11 @@ fn accumulation_stays_exact_after_1e5_samples() {
 #[test]
 fn single_sample_batches_accumulate_exactly() {
     let s = constant_environment(1000);
-    let gpu_scene = pathlight_core::GpuScene::build(&s);
-    let mut renderer =
-        pathlight_render::ProgressiveRenderer::new(context(), &s, &gpu_scene).unwrap();
+    let mut renderer = gpu_renderer(&s);
     for _ in 0..1000 {
         assert_eq!(renderer.advance(1).unwrap(), 1);
     }
-    let film = renderer.read_film().unwrap();
+    let film = renderer.film().unwrap();
     assert_eq!(film.spp, 1000);
     assert_exactly_one_tenth(&film, "1000 one-sample batches of 0.1");
 }
@@ -181,16 +180,12 @@ fn single_sample_batches_accumulate_exactly() {
 fn batching_does_not_change_the_image() {
     let mut s = scene("refs/cornell-spheres.toml", 37, 6, 4);
     s.camera.width = 45;
-    let gpu_scene = pathlight_core::GpuScene::build(&s);
     let render_with = |piece: Option<(u32, u32)>| {
-        let mut r = pathlight_render::ProgressiveRenderer::new(context(), &s, &gpu_scene).unwrap();
+        let mut r = gpu_renderer(&s);
         if let Some((rows, samples)) = piece {
             r.set_piece(rows, samples);
         }
-        while r.samples_done() < 6 {
-            r.advance(6 - r.samples_done()).unwrap();
-        }
-        r.read_film().unwrap()
+        render_to(&mut r, 6)
     };
     let adaptive = render_with(None);
     assert_eq!(render_with(Some((5, 1))), adaptive);
@@ -200,25 +195,24 @@ fn batching_does_not_change_the_image() {
 /// The viewer's schedule: frames rendered band by band (`step_frame`, a tiny time target so
 /// every band is one workgroup of rows), and the other ways to add frames, give the same
 /// image; mid-frame, the rows already sampled are divided by their own count; after
-/// `set_scene` with a new size and camera, the image is that of a fresh renderer.
+/// `set_camera` with a new size and camera, and after `set_materials` with a light
+/// toggled, the image is that of a fresh renderer.
 #[test]
 fn frames_in_bands_and_scene_changes_keep_the_image_exact() {
     let s = scene("refs/cornell-spheres.toml", 24, 3, 4);
-    let gpu_scene = pathlight_core::GpuScene::build(&s);
-    let mut reference =
-        pathlight_render::ProgressiveRenderer::new(context(), &s, &gpu_scene).unwrap();
+    let mut reference = gpu_renderer(&s);
     for _ in 0..3 {
-        reference.submit_frame();
+        reference.queue_frame().unwrap();
     }
     reference.finish().unwrap();
-    let reference = reference.read_film().unwrap();
-    let mut r = pathlight_render::ProgressiveRenderer::new(context(), &s, &gpu_scene).unwrap();
+    let reference = reference.film().unwrap();
+    let mut r = gpu_renderer(&s);
     let (mut frames, mut partials) = (0, 0);
     while frames < 3 {
         frames += u32::from(r.step_frame(std::time::Duration::ZERO).unwrap());
         if frames == 2 && r.rows_ahead() > 0 {
             // Mid-frame: the sampled rows equal a 3-sample image, the rest a 2-sample one.
-            let partial = r.read_film().unwrap();
+            let partial = r.film().unwrap();
             let ahead = (r.rows_ahead() * 24) as usize;
             assert_eq!(partial.pixels[..ahead], reference.pixels[..ahead]);
             assert_ne!(partial.pixels[ahead..], reference.pixels[ahead..]);
@@ -226,16 +220,32 @@ fn frames_in_bands_and_scene_changes_keep_the_image_exact() {
         }
     }
     assert!(partials >= 2, "the third frame took {partials} + 1 bands");
-    assert_eq!(r.read_film().unwrap(), reference);
+    assert_eq!(r.film().unwrap(), reference);
 
     let mut moved = scene("refs/cornell-spheres.toml", 16, 2, 4);
     moved.camera.position.x += 0.3;
-    r.set_scene(&moved, &gpu_scene).unwrap();
+    r.set_camera(&moved.camera).unwrap();
     assert_eq!(r.samples_done(), 0);
     for _ in 0..2 {
         while !r.step_frame(std::time::Duration::ZERO).unwrap() {}
     }
-    assert_eq!(r.read_film().unwrap(), render(&moved));
+    assert_eq!(r.film().unwrap(), render(&moved));
+
+    // The diffuse sphere becomes a light: only the materials and the light table change.
+    let mut lit = moved.clone();
+    let sphere = lit
+        .objects
+        .iter()
+        .position(|o| o.name == "diffuse_sphere")
+        .unwrap();
+    let mut glow = lit.materials[lit.objects[sphere].material as usize].clone();
+    glow.emission = Vec3::new(4.0, 3.0, 2.0);
+    lit.materials.push(glow);
+    lit.objects[sphere].material = lit.materials.len() as u32 - 1;
+    let shading = PreparedScene::new(&s).shading_of(&lit);
+    assert!(shading.light_count > 1);
+    r.set_materials(&shading).unwrap();
+    assert_eq!(render_to(&mut r, 2), render(&lit));
 }
 
 /// Same seed, same image, bit for bit, however the work is batched; another seed differs.

@@ -1,22 +1,27 @@
 //! The WGSL traversal (`intersect.wgsl`, `bvh.wgsl`) against its CPU twin on random rays
 //! through the default scene (quads, spheres, capped cylinders and a 6k-triangle mesh). The
-//! twin itself is checked against brute force in `crates/core/tests/bvh.rs`.
+//! twin itself is checked against brute force in `crates/cpu/src/bvh.rs`.
 
 use crate::common::context;
 use glam::{Vec2, Vec3};
-use pathlight_core::gpu::{KIND_MESH, NO_TRIANGLE, SHAPE_LEAF};
-use pathlight_core::scene::TriangleMesh;
-use pathlight_core::trace::{Hit, MISS, Ray, intersect_triangle};
-use pathlight_core::{GpuScene, Object, Shape, Tracer, WideBvh, default_scene};
+use pathlight_core::PreparedScene;
+use pathlight_core::gpu_types::{KIND_MESH, NO_TRIANGLE, SHAPE_LEAF};
+use pathlight_cpu::bvh::Hit;
+use pathlight_cpu::intersect::{MISS, Ray, intersect_triangle_edges};
+use pathlight_cpu::{CpuScene, Tracer};
 use pathlight_render::Accel;
-use pathlight_render::scene_buffers::{SceneBuffers, create_compute_pipeline, storage_entry};
-use pathlight_render::shaders;
+use pathlight_render::pipeline::{create_compute_pipeline, storage_entry};
+use pathlight_render::scene_buffers::SceneBuffers;
+use pathlight_render::wgsl;
+use pathlight_scene::{Object, Shape, TriangleMesh, default_scene};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use wgpu::util::DeviceExt;
 
 /// A test-only pass: one ray per invocation, nearest hit written back.
 const KERNEL: &str = r#"
+#import bvh
+
 struct TraceRay { origin: vec3f, t_max: f32, dir: vec3f, pad: f32 }
 struct TraceHit { t: f32, object: u32, primitive: u32, blocked: u32 }
 @group(1) @binding(0) var<storage, read> rays: array<TraceRay>;
@@ -57,27 +62,27 @@ struct TraceHit {
 /// `rays` traced on the GPU with the scheme `accel` and a traversal stack of the scene's bound
 /// divided by `stack_divisor` (1: as the integrator sizes it).
 fn trace_on_gpu(
-    gpu_scene: &GpuScene,
+    prepared: &PreparedScene,
     rays: &[TraceRay],
     accel: Accel,
     stack_divisor: u32,
 ) -> Vec<TraceHit> {
     let ctx = context();
     let device = &ctx.device;
-    let scene = SceneBuffers::upload(device, gpu_scene).unwrap();
+    let scene = SceneBuffers::upload(device, prepared).unwrap();
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("trace test"),
         entries: &[storage_entry(0, true), storage_entry(1, false)],
     });
-    let source = format!(
-        "const OBJECT_COUNT: u32 = {}u;\n{}{}",
-        gpu_scene.object_count,
-        shaders::with_stack_size(
-            &shaders::ray_query_library(),
-            scene.stack_bound / stack_divisor
+    let stack = prepared.geometry.stack_bound / stack_divisor;
+    let source = wgsl::assemble_source(
+        &format!(
+            "const OBJECT_COUNT: u32 = {}u;\n{KERNEL}",
+            prepared.shading.object_count
         ),
-        KERNEL
-    );
+        &[("STACK_SIZE", stack.max(1))],
+    )
+    .unwrap();
     let pipeline = create_compute_pipeline(
         device,
         "trace test",
@@ -172,13 +177,13 @@ fn room_rays(seed: u64, count: usize) -> Vec<TraceRay> {
 /// Every acceleration scheme finds what the CPU twin finds.
 #[test]
 fn wgsl_traversal_matches_cpu_twin() {
-    let gpu_scene = GpuScene::build(&default_scene::load().unwrap());
+    let prepared = PreparedScene::new(&default_scene::load().unwrap());
     let rays = room_rays(5, 20_000);
     for accel in Accel::ALL {
         check_hits(
-            &gpu_scene,
+            &prepared,
             &rays,
-            &trace_on_gpu(&gpu_scene, &rays, accel, 1),
+            &trace_on_gpu(&prepared, &rays, accel, 1),
             accel,
         );
     }
@@ -226,18 +231,19 @@ fn wgsl_traversal_matches_cpu_twin_in_mixed_leaves() {
         material,
         shape: Shape::Mesh(cloud),
     });
-    let gpu_scene = GpuScene::build(&scene);
-    let mixed = WideBvh::build(&gpu_scene)
-        .gpu_nodes()
+    let prepared = PreparedScene::new(&scene);
+    let g = &prepared.geometry;
+    let mixed = g
+        .nodes
         .iter()
         .flat_map(|n| (0..4).map(|lane| (n.first[lane], n.count[lane])))
         .filter(|&(first, count)| {
             let count = count & !SHAPE_LEAF;
             count != 0
-                && gpu_scene.primitives[first as usize..(first + count) as usize]
+                && g.primitives[first as usize..(first + count) as usize]
                     .iter()
                     .any(|p| p.triangle != NO_TRIANGLE)
-                && gpu_scene.primitives[first as usize..(first + count) as usize]
+                && g.primitives[first as usize..(first + count) as usize]
                     .iter()
                     .any(|p| p.triangle == NO_TRIANGLE)
         })
@@ -248,9 +254,9 @@ fn wgsl_traversal_matches_cpu_twin_in_mixed_leaves() {
     );
     let rays = room_rays(6, 20_000);
     check_hits(
-        &gpu_scene,
+        &prepared,
         &rays,
-        &trace_on_gpu(&gpu_scene, &rays, Accel::Bvh, 1),
+        &trace_on_gpu(&prepared, &rays, Accel::Bvh, 1),
         Accel::Bvh,
     );
 }
@@ -266,12 +272,11 @@ fn a_scene_without_primitives_hits_nothing() {
         material,
         shape: Shape::Mesh(TriangleMesh::default()),
     }];
-    let gpu_scene = GpuScene::build(&scene);
-    assert!(gpu_scene.primitives.is_empty());
-    let wide = WideBvh::build(&gpu_scene);
+    let prepared = PreparedScene::new(&scene);
+    assert!(prepared.geometry.primitives.is_empty());
     // The GPU's placeholder: four unused children (inverted boxes), so that no ray enters
     // it and loops (an empty box at the origin would be entered by rays through the origin).
-    let nodes = wide.gpu_nodes();
+    let nodes = &prepared.geometry.nodes;
     assert_eq!(nodes.len(), 1);
     let n = nodes[0];
     for lane in 0..4 {
@@ -284,23 +289,25 @@ fn a_scene_without_primitives_hits_nothing() {
     }
     let rays = room_rays(7, 256);
     for accel in Accel::ALL {
-        let hits = trace_on_gpu(&gpu_scene, &rays, accel, 1);
+        let hits = trace_on_gpu(&prepared, &rays, accel, 1);
         assert!(
             hits.iter().all(|h| h.object == u32::MAX && h.blocked == 0),
             "{accel:?}: a hit in an empty scene"
         );
     }
-    let mut tracer = Tracer::new(&gpu_scene, &wide);
+    let view = CpuScene::new(&prepared);
+    let mut tracer = Tracer::new(&view);
     for ray in &rays {
         assert_eq!(tracer.intersect(&ray_of(ray), ray.t_max), None);
-        assert_eq!(gpu_scene.intersect(&ray_of(ray), ray.t_max), None);
     }
 }
 
-fn check_hits(gpu_scene: &GpuScene, rays: &[TraceRay], hits: &[TraceHit], accel: Accel) {
+fn check_hits(prepared: &PreparedScene, rays: &[TraceRay], hits: &[TraceHit], accel: Accel) {
+    let view = CpuScene::new(prepared);
+    let mut tracer = Tracer::new(&view);
     let (mut hit_count, mut mesh_hits, mut ties) = (0, 0, 0);
     for (ray, gpu) in rays.iter().zip(hits) {
-        let cpu = gpu_scene.intersect(&ray_of(ray), ray.t_max);
+        let cpu = tracer.intersect(&ray_of(ray), ray.t_max);
         assert_eq!(
             gpu.blocked == 1,
             cpu.is_some(),
@@ -322,14 +329,14 @@ fn check_hits(gpu_scene: &GpuScene, rays: &[TraceRay], hits: &[TraceHit], accel:
                     // A tie: a ray through a shared edge, or onto two coincident surfaces
                     // (the vase's base on the floor), may report either primitive, but the
                     // GPU's must lie at the same distance.
-                    let t = distance_to(gpu_scene, &ray_of(ray), gpu.object, gpu.primitive);
+                    let t = distance_to(&view, &ray_of(ray), gpu.object, gpu.primitive);
                     assert!(
                         (t - cpu.t).abs() <= 1e-5 * cpu.t.max(1.0),
                         "{accel:?}: GPU {gpu:?} (at {t}) where the CPU twin hits {cpu:?}"
                     );
                     ties += 1;
                 }
-                mesh_hits += usize::from(gpu_scene.objects[gpu.object as usize].kind == KIND_MESH);
+                mesh_hits += usize::from(view.objects[gpu.object as usize].kind == KIND_MESH);
             }
         }
     }
@@ -344,20 +351,17 @@ fn check_hits(gpu_scene: &GpuScene, rays: &[TraceRay], hits: &[TraceHit], accel:
 }
 
 fn ray_of(ray: &TraceRay) -> Ray {
-    Ray {
-        origin: ray.origin.into(),
-        dir: ray.dir.into(),
-    }
+    Ray::new(Vec3::from(ray.origin), Vec3::from(ray.dir))
 }
 
 /// Where `ray` meets primitive `primitive` of object `object` (a hit's pair), or MISS.
-fn distance_to(gpu_scene: &GpuScene, ray: &Ray, object: u32, primitive: u32) -> f32 {
-    if gpu_scene.objects[object as usize].kind == KIND_MESH {
-        let [v0, v1, v2] = gpu_scene.triangle(primitive);
-        intersect_triangle(v0, v1, v2, ray, MISS).0
+fn distance_to(scene: &CpuScene, ray: &Ray, object: u32, primitive: u32) -> f32 {
+    if scene.objects[object as usize].kind == KIND_MESH {
+        let [v0, v1, v2] = scene.triangle(primitive);
+        intersect_triangle_edges(v0, v1 - v0, v2 - v0, ray, MISS).0
     } else {
         let mut hit = Hit::none(MISS);
-        gpu_scene.intersect_shape(object, ray, &mut hit);
+        scene.intersect_shape(object, ray, &mut hit);
         hit.t
     }
 }
@@ -394,14 +398,14 @@ fn traversal_stack_bound_holds_the_deepest_walk() {
     for (j, &(x, y)) in lines.iter().enumerate() {
         sphere(&mut text, Vec3::new(x, y, -0.3 * j as f32 - 0.15), 0.004);
     }
-    let scene = pathlight_core::load_scene(&pathlight_core::SceneSource {
+    let scene = pathlight_scene::load_scene(&pathlight_scene::SceneSource {
         name: "sphere row".into(),
         text: &text,
         base_dir: Default::default(),
         embedded: &[],
     })
     .unwrap();
-    let gpu_scene = GpuScene::build(&scene);
+    let prepared = PreparedScene::new(&scene);
     let rays: Vec<TraceRay> = lines
         .iter()
         .map(|&(x, y)| TraceRay {
@@ -412,7 +416,7 @@ fn traversal_stack_bound_holds_the_deepest_walk() {
         })
         .collect();
     let targets_found = |stack_divisor: u32| {
-        let hits = trace_on_gpu(&gpu_scene, &rays, Accel::Bvh, stack_divisor);
+        let hits = trace_on_gpu(&prepared, &rays, Accel::Bvh, stack_divisor);
         hits.iter()
             .enumerate()
             .filter(|(j, hit)| hit.object != u32::MAX && hit.object as usize == SPHERES + j)

@@ -2,10 +2,7 @@
 //! same code give the same image, up to float differences that may flip a rare discrete
 //! choice (lobe, roulette). Checked on every material and emitter kind.
 
-use pathlight_core::GpuScene;
-use pathlight_cpu::CpuRenderer;
-
-use crate::common::{render, scene};
+use crate::common::{render, render_cpu, scene};
 
 #[test]
 fn gpu_and_cpu_render_the_same_image() {
@@ -16,11 +13,7 @@ fn gpu_and_cpu_render_the_same_image() {
     ] {
         let s = scene(name, 40, 4, 2);
         let gpu = render(&s);
-        let mut cpu = CpuRenderer::new(&s, GpuScene::build(&s));
-        while cpu.samples_done() < 4 {
-            cpu.advance(4 - cpu.samples_done());
-        }
-        let cpu = cpu.film();
+        let cpu = render_cpu(&s);
         let close = gpu
             .pixels
             .iter()

@@ -1,0 +1,91 @@
+//! What every command does first: load the scene, apply the command line's overrides,
+//! prepare it once, and open the backend that renders it.
+
+use anyhow::Context;
+use pathlight_core::{PreparedScene, Renderer};
+use pathlight_cpu::{CpuRenderer, InstructionSet};
+use pathlight_render::context::describe;
+use pathlight_render::{Accel, GpuContext, GpuRenderer};
+use pathlight_scene::settings::{check_max_depth, check_resolution};
+use pathlight_scene::{Sampler, Scene, default_scene, load_scene_file};
+
+use crate::cli::{Backend, DeviceArgs, SamplerChoice, SceneArgs};
+
+/// Loads the scene named on the command line (or the default scene) with its overrides
+/// applied, refusing bad values.
+pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Scene> {
+    let mut scene = match &args.scene {
+        Some(path) => load_scene_file(path)?,
+        None => default_scene::load().context("the built-in default scene")?,
+    };
+    if let Some(width) = args.width {
+        scene.camera.width = width;
+    }
+    if let Some(height) = args.height {
+        scene.camera.height = height;
+    }
+    check_resolution(scene.camera.width, scene.camera.height)?;
+    if let Some(max_depth) = args.max_depth {
+        scene.settings.max_depth = max_depth;
+    }
+    check_max_depth(scene.settings.max_depth)?;
+    if let Some(seed) = args.seed {
+        scene.settings.seed = seed;
+    }
+    if let Some(sampler) = args.sampler {
+        scene.settings.sampler = match sampler {
+            SamplerChoice::Sobol => Sampler::Sobol,
+            SamplerChoice::Independent => Sampler::Independent,
+        };
+    }
+    Ok(scene)
+}
+
+/// The device a command renders on: a wgpu adapter, or the CPU backend.
+#[expect(
+    clippy::large_enum_variant,
+    reason = "one per command; boxing the context would buy nothing"
+)]
+pub enum Device {
+    /// WGSL on this adapter.
+    Gpu(GpuContext),
+    /// The native CPU backend.
+    Cpu,
+}
+
+impl Device {
+    /// Opens the device the arguments ask for.
+    pub fn open(args: &DeviceArgs) -> anyhow::Result<Self> {
+        Ok(match args.backend {
+            Backend::Gpu => Device::Gpu(GpuContext::new(args.adapter.as_deref())?),
+            Backend::Cpu => Device::Cpu,
+        })
+    }
+
+    /// Where rendering runs, for messages and reports: the adapter, or the CPU backend.
+    pub fn describe(&self) -> String {
+        match self {
+            Device::Gpu(ctx) => describe(&ctx.adapter_info),
+            Device::Cpu => pathlight_cpu::describe(InstructionSet::best()),
+        }
+    }
+
+    /// A progressive render of `prepared` (the scene `scene` prepared) on this device,
+    /// finding hits with `accel` (the GPU offers the seed's slower schemes too).
+    pub fn renderer(
+        &self,
+        scene: &Scene,
+        prepared: &PreparedScene,
+        accel: Accel,
+    ) -> anyhow::Result<Box<dyn Renderer>> {
+        let (camera, settings) = (&scene.camera, &scene.settings);
+        Ok(match self {
+            Device::Gpu(ctx) => Box::new(GpuRenderer::new(ctx, prepared, camera, settings, accel)?),
+            Device::Cpu if accel != Accel::Bvh => anyhow::bail!(
+                "--accel {} needs the GPU backend; the CPU backend has only the BVH",
+                accel.name()
+            ),
+            Device::Cpu => Box::new(CpuRenderer::new(prepared, camera, settings)),
+        })
+    }
+}

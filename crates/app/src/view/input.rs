@@ -1,0 +1,128 @@
+//! The viewer's input: mouse and keys turned into [`Action`]s (README lists them).
+
+use winit::dpi::PhysicalPosition;
+use winit::event::{ElementState, KeyEvent, MouseButton, MouseScrollDelta};
+use winit::keyboard::{Key, ModifiersState, NamedKey};
+
+/// Pointer travel (pixels) that turns a press into a drag instead of a click.
+const DRAG_THRESHOLD: f64 = 4.0;
+
+/// What the user asked for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Action {
+    /// Close the window (`Esc`).
+    Quit,
+    /// Pause or resume rendering (`Space`).
+    TogglePause,
+    /// Save the image (`S`).
+    Save,
+    /// Start the image over (`R`).
+    Restart,
+    /// The next tone mapper (`T`).
+    CycleTonemap,
+    /// Start the next iteration (right click).
+    NextIteration,
+    /// Toggle the object under this window point between light and material (left click).
+    Click(PhysicalPosition<f64>),
+    /// Orbit by this many pixels dragged (left drag).
+    Orbit(f32, f32),
+    /// Pan by this many pixels dragged (middle drag, or shift + left drag).
+    Pan(f32, f32),
+    /// Zoom by this many wheel steps.
+    Zoom(f32),
+}
+
+/// Pointer state for clicks and drags.
+#[derive(Debug, Default)]
+pub struct Pointer {
+    position: PhysicalPosition<f64>,
+    /// Where the left or middle button went down, and whether it has become a drag.
+    pressed_at: Option<PhysicalPosition<f64>>,
+    dragging: bool,
+    left: bool,
+    middle: bool,
+    modifiers: ModifiersState,
+}
+
+impl Pointer {
+    /// The modifier keys changed.
+    pub fn set_modifiers(&mut self, modifiers: ModifiersState) {
+        self.modifiers = modifiers;
+    }
+
+    /// The pointer moved to `position`: a drag past the threshold orbits or pans.
+    pub fn moved(&mut self, position: PhysicalPosition<f64>) -> Option<Action> {
+        let (dx, dy) = (
+            (position.x - self.position.x) as f32,
+            (position.y - self.position.y) as f32,
+        );
+        self.position = position;
+        let start = self.pressed_at?;
+        if !self.dragging {
+            let travel = (position.x - start.x).hypot(position.y - start.y);
+            if travel < DRAG_THRESHOLD {
+                return None;
+            }
+            self.dragging = true;
+        }
+        if self.middle || self.modifiers.shift_key() {
+            Some(Action::Pan(dx, dy))
+        } else if self.left {
+            Some(Action::Orbit(dx, dy))
+        } else {
+            None
+        }
+    }
+
+    /// A button went down or up: a left press and release without a drag is a click, a
+    /// right press asks for the next iteration.
+    pub fn button(&mut self, state: ElementState, button: MouseButton) -> Option<Action> {
+        let pressed = state == ElementState::Pressed;
+        match button {
+            MouseButton::Left | MouseButton::Middle => {
+                if button == MouseButton::Left {
+                    self.left = pressed;
+                } else {
+                    self.middle = pressed;
+                }
+                if pressed {
+                    self.pressed_at = Some(self.position);
+                    self.dragging = false;
+                    return None;
+                }
+                let was_click = !self.dragging && self.pressed_at.is_some();
+                self.pressed_at = None;
+                self.dragging = false;
+                (was_click && button == MouseButton::Left).then_some(Action::Click(self.position))
+            }
+            MouseButton::Right if pressed => Some(Action::NextIteration),
+            _ => None,
+        }
+    }
+}
+
+/// The action of a key press (repeats and releases do nothing).
+pub fn key_action(event: &KeyEvent) -> Option<Action> {
+    if event.state != ElementState::Pressed || event.repeat {
+        return None;
+    }
+    match &event.logical_key {
+        Key::Named(NamedKey::Escape) => Some(Action::Quit),
+        Key::Named(NamedKey::Space) => Some(Action::TogglePause),
+        Key::Character(c) => match c.to_lowercase().as_str() {
+            "s" => Some(Action::Save),
+            "r" => Some(Action::Restart),
+            "t" => Some(Action::CycleTonemap),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// The zoom of a wheel turn, in steps.
+pub fn wheel_action(delta: MouseScrollDelta) -> Action {
+    Action::Zoom(match delta {
+        MouseScrollDelta::LineDelta(_, y) => y,
+        MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+    })
+}

@@ -1,0 +1,142 @@
+//! The acceleration structure both backends walk: an obvhs BVH2 over every primitive of the
+//! scene (PLOC build, reinsertion, SAH-driven leaf collapse) collapsed into a 4-wide tree
+//! whose four child boxes a ray tests at once (in SIMD lanes on the CPU, as `vec4f`s in
+//! `bvh.wgsl`). A ray visits about half as many nodes as in the binary tree.
+
+use std::time::Duration;
+
+use obvhs::BvhBuildParams;
+use obvhs::aabb::Aabb;
+use obvhs::bvh2::builder::build_bvh2;
+use obvhs::bvh2::node::Bvh2Node;
+
+use crate::gpu_types::{GpuWideNode, SHAPE_LEAF};
+
+/// A binary tree over primitive boxes, and the order in which its leaves hold them.
+pub(crate) struct BinaryTree {
+    /// The nodes, root at 0: an inner node's children are `first_index` and
+    /// `first_index + 1`; a leaf holds `first_index .. first_index + prim_count` of the
+    /// reordered primitives.
+    pub nodes: Vec<Bvh2Node>,
+    /// Per leaf slot, the index of the primitive box it holds.
+    pub primitive_indices: Vec<u32>,
+}
+
+/// Builds the binary tree over `bounds` (not empty) with obvhs' medium preset
+/// (SAH-quality PLOC with reinsertion), on every core.
+pub(crate) fn build_binary(bounds: &[Aabb]) -> BinaryTree {
+    let mut build_time = Duration::ZERO;
+    let tree = build_bvh2(bounds, BvhBuildParams::medium_build(), &mut build_time);
+    BinaryTree {
+        nodes: tree.nodes,
+        primitive_indices: tree.primitive_indices,
+    }
+}
+
+/// The one node of a tree without primitives: four unused children, which no ray enters.
+pub(crate) fn empty_tree() -> Vec<GpuWideNode> {
+    vec![GpuWideNode {
+        lo_x: [f32::INFINITY; 4],
+        lo_y: [f32::INFINITY; 4],
+        lo_z: [f32::INFINITY; 4],
+        hi_x: [f32::NEG_INFINITY; 4],
+        hi_y: [f32::NEG_INFINITY; 4],
+        hi_z: [f32::NEG_INFINITY; 4],
+        first: [0; 4],
+        count: [0; 4],
+    }]
+}
+
+/// The 4-wide form of `tree`, root at 0, in pre-order. Each wide node takes the binary
+/// node's children and keeps opening its largest inner child (by surface area) until it has
+/// four. A leaf child holding a whole shape (`is_shape` of its first primitive slot ..) is
+/// marked [`SHAPE_LEAF`]; an unused child has an inverted box.
+pub(crate) fn collapse(tree: &BinaryTree, is_shape: &[bool]) -> Vec<GpuWideNode> {
+    let mut out = Vec::new();
+    collapse_node(&tree.nodes, is_shape, 0, &mut out);
+    out
+}
+
+/// Appends the 4-wide form of the binary subtree at `root`; returns its node index.
+fn collapse_node(
+    nodes: &[Bvh2Node],
+    is_shape: &[bool],
+    root: u32,
+    out: &mut Vec<GpuWideNode>,
+) -> u32 {
+    let index = out.len() as u32;
+    out.extend(empty_tree());
+    let node = &nodes[root as usize];
+    let mut children: Vec<u32> = if node.prim_count > 0 {
+        vec![root]
+    } else {
+        vec![node.first_index, node.first_index + 1]
+    };
+    while children.len() < 4 {
+        let widest = children
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| nodes[**c as usize].prim_count == 0)
+            .max_by(|(_, a), (_, b)| {
+                let area = |i: u32| nodes[i as usize].aabb.half_area();
+                area(**a).total_cmp(&area(**b))
+            })
+            .map(|(i, _)| i);
+        let Some(i) = widest else { break };
+        let opened = children.swap_remove(i);
+        let first = nodes[opened as usize].first_index;
+        children.extend([first, first + 1]);
+    }
+    for (lane, &child) in children.iter().enumerate() {
+        let c = &nodes[child as usize];
+        let (first, count) = if c.prim_count > 0 {
+            let slots = c.first_index as usize..(c.first_index + c.prim_count) as usize;
+            let shape = is_shape[slots].iter().any(|&s| s);
+            let mark = if shape { SHAPE_LEAF } else { 0 };
+            (c.first_index, c.prim_count | mark)
+        } else {
+            (collapse_node(nodes, is_shape, child, out), 0)
+        };
+        let n = &mut out[index as usize];
+        let (lo, hi) = (c.aabb.min, c.aabb.max);
+        n.lo_x[lane] = lo.x;
+        n.lo_y[lane] = lo.y;
+        n.lo_z[lane] = lo.z;
+        n.hi_x[lane] = hi.x;
+        n.hi_y[lane] = hi.y;
+        n.hi_z[lane] = hi.z;
+        n.first[lane] = first;
+        n.count[lane] = count;
+    }
+    index
+}
+
+/// Whether child `lane` of `node` is used (an unused one has an inverted box).
+pub fn lane_used(node: &GpuWideNode, lane: usize) -> bool {
+    node.lo_x[lane] <= node.hi_x[lane]
+}
+
+/// Most entries the traversal stack of WGSL `trace_scene` can hold at once in the tree
+/// `nodes`. At each node the walk tests the entered leaves that hold shapes at once and
+/// pushes the other entered children but the nearest, and the stack holds only the pending
+/// entries of the current node and its ancestors (an entry is popped before its node is
+/// visited). At least 1: WGSL has no empty arrays.
+pub fn stack_bound(nodes: &[GpuWideNode]) -> u32 {
+    path_pushes(nodes, 0).max(1)
+}
+
+/// Most entries pushed along one path down from `node`.
+fn path_pushes(nodes: &[GpuWideNode], node: u32) -> u32 {
+    let n = &nodes[node as usize];
+    let used = (0..4).filter(|&lane| lane_used(n, lane));
+    let pushed = used
+        .clone()
+        .filter(|&lane| n.count[lane] & SHAPE_LEAF == 0)
+        .count() as u32;
+    let below = used
+        .filter(|&lane| n.count[lane] == 0)
+        .map(|lane| path_pushes(nodes, n.first[lane]))
+        .max()
+        .unwrap_or(0);
+    pushed.saturating_sub(1) + below
+}

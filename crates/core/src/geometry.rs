@@ -1,0 +1,505 @@
+//! The scene's shapes as the backends trace them, built once per scene: every quad, sphere
+//! and cylinder and every triangle of every mesh as one primitive of one BVH
+//! ([`crate::bvh`]), the primitives in leaf order, and the meshes' vertices.
+//!
+//! Meshes are not instanced (their triangles are in world space), so one tree over
+//! everything is as tight as two levels and sends no ray from a top-level walk into a
+//! mesh's.
+
+use std::time::{Duration, Instant};
+
+use bytemuck::Zeroable;
+use glam::{Vec3, Vec3A};
+use obvhs::aabb::Aabb;
+use pathlight_scene::{Object, Shape, TriangleMesh};
+use rayon::prelude::*;
+
+use crate::bvh;
+use crate::gpu_types::{
+    FLAG_CAPS, FLAG_FLAT, GpuObject, GpuPrimitive, GpuVertex, GpuWideNode, KIND_CYLINDER,
+    KIND_MESH, KIND_QUAD, KIND_SPHERE, NO_LIGHT, NO_TRIANGLE,
+};
+
+/// The traced form of a scene's objects. It does not depend on materials, lights or the
+/// camera, so it is built once and shared (both backends read it, and a light toggle or a
+/// camera move keeps it).
+#[derive(Debug, Clone)]
+pub struct Geometry {
+    /// The 4-wide BVH over [`Self::primitives`], root at 0. Never empty (a node that no ray
+    /// enters when there are no primitives).
+    pub nodes: Vec<GpuWideNode>,
+    /// Every shape and triangle, in leaf order.
+    pub primitives: Vec<GpuPrimitive>,
+    /// Triangle corners, three per triangle, each mesh's triangles together (in leaf
+    /// order). Never empty.
+    pub vertices: Vec<GpuVertex>,
+    /// Per object (the scene's order): its shape, with material 0 and no light (the
+    /// materials and the light table are [`crate::Shading`]'s).
+    pub shapes: Vec<GpuObject>,
+    /// Most entries the GPU's traversal stack needs ([`bvh::stack_bound`]).
+    pub stack_bound: u32,
+    /// How long the build took.
+    pub build_time: Duration,
+}
+
+/// A primitive before the build: object `object`, and `triangle` of its mesh or
+/// [`NO_TRIANGLE`] for a whole shape.
+#[derive(Clone, Copy)]
+struct PrimitiveRef {
+    object: u32,
+    triangle: u32,
+}
+
+impl Geometry {
+    /// Builds the BVH over every primitive of `objects` and flattens them.
+    pub fn build(objects: &[Object]) -> Self {
+        let started = Instant::now();
+        let mut shapes = Vec::with_capacity(objects.len());
+        let mut refs = Vec::new();
+        let mut bounds = Vec::new();
+        for (i, object) in objects.iter().enumerate() {
+            let object_bounds = shape_bounds(&object.shape);
+            shapes.push(gpu_shape(&object.shape, &object_bounds));
+            let i = i as u32;
+            if let Shape::Mesh(mesh) = &object.shape {
+                refs.extend((0..mesh.indices.len() as u32).map(|t| PrimitiveRef {
+                    object: i,
+                    triangle: t,
+                }));
+                bounds.par_extend(
+                    (0..mesh.indices.len())
+                        .into_par_iter()
+                        .map(|t| triangle_bounds(mesh, t)),
+                );
+            } else {
+                refs.push(PrimitiveRef {
+                    object: i,
+                    triangle: NO_TRIANGLE,
+                });
+                bounds.push(object_bounds);
+            }
+        }
+        let mut out = Geometry {
+            nodes: bvh::empty_tree(),
+            primitives: Vec::new(),
+            vertices: Vec::new(),
+            shapes,
+            stack_bound: 1,
+            build_time: Duration::ZERO,
+        };
+        if !refs.is_empty() {
+            let tree = bvh::build_binary(&bounds);
+            let leaf_order: Vec<PrimitiveRef> = tree
+                .primitive_indices
+                .iter()
+                .map(|&p| refs[p as usize])
+                .collect();
+            let is_shape: Vec<bool> = leaf_order
+                .iter()
+                .map(|p| p.triangle == NO_TRIANGLE)
+                .collect();
+            out.nodes = bvh::collapse(&tree, &is_shape);
+            out.stack_bound = bvh::stack_bound(&out.nodes);
+            out.lay_out_primitives(objects, &leaf_order);
+        }
+        if out.vertices.is_empty() {
+            out.vertices.push(GpuVertex::zeroed());
+        }
+        out.build_time = started.elapsed();
+        out
+    }
+
+    /// Triangle `i`'s corner positions (`i` in triangles of the vertex buffer).
+    #[inline(always)]
+    pub fn triangle(&self, i: u32) -> [Vec3; 3] {
+        let i = 3 * i as usize;
+        [0, 1, 2].map(|k| Vec3::from(self.vertices[i + k].position))
+    }
+
+    /// Number of triangles in the scene.
+    pub fn triangle_count(&self) -> usize {
+        self.shapes.iter().map(|s| s.triangle_count as usize).sum()
+    }
+
+    /// Fills the vertex buffer, each mesh's triangles together in the order the leaves hold
+    /// them (so that a leaf's triangles lie side by side for shading too), and the
+    /// primitives in leaf order. One pass numbers the triangles; both buffers are then
+    /// written in parallel, each in its own order (a 1M-triangle mesh: 150 MB).
+    fn lay_out_primitives(&mut self, objects: &[Object], leaf_order: &[PrimitiveRef]) {
+        // Per object, the vertex-buffer triangle its next leaf-order triangle takes.
+        let mut next = vec![0u32; objects.len()];
+        let mut total = 0u32;
+        for (i, object) in objects.iter().enumerate() {
+            if let Shape::Mesh(mesh) = &object.shape {
+                let count = mesh.indices.len() as u32;
+                self.shapes[i].first_triangle = total;
+                self.shapes[i].triangle_count = count;
+                next[i] = total;
+                total += count;
+            }
+        }
+        // Per leaf, its vertex-buffer triangle; per vertex-buffer triangle, its leaf's.
+        let mut held = vec![
+            PrimitiveRef {
+                object: 0,
+                triangle: 0,
+            };
+            total as usize
+        ];
+        let slots: Vec<u32> = leaf_order
+            .iter()
+            .map(|p| {
+                if p.triangle == NO_TRIANGLE {
+                    return NO_TRIANGLE;
+                }
+                let slot = next[p.object as usize];
+                next[p.object as usize] += 1;
+                held[slot as usize] = *p;
+                slot
+            })
+            .collect();
+        let mesh_of = |p: &PrimitiveRef| match &objects[p.object as usize].shape {
+            Shape::Mesh(mesh) => Some(mesh),
+            _ => None,
+        };
+        self.vertices = held
+            .par_iter()
+            .map(|p| {
+                let Some(mesh) = mesh_of(p) else {
+                    return [GpuVertex::zeroed(); 3]; // Not reached: every slot is a mesh's.
+                };
+                mesh.indices[p.triangle as usize].map(|v| {
+                    let v = v as usize;
+                    let uv = mesh.uvs.get(v).copied().unwrap_or_default();
+                    GpuVertex {
+                        position: mesh.positions[v].to_array(),
+                        u: uv.x,
+                        normal: mesh.normals.get(v).copied().unwrap_or_default().to_array(),
+                        v: uv.y,
+                    }
+                })
+            })
+            .collect::<Vec<[GpuVertex; 3]>>()
+            .into_flattened();
+        self.primitives = leaf_order
+            .par_iter()
+            .zip(slots)
+            .map(|(p, slot)| {
+                let mut primitive = GpuPrimitive {
+                    object: p.object,
+                    triangle: slot,
+                    ..GpuPrimitive::zeroed()
+                };
+                if let Some(mesh) = mesh_of(p) {
+                    let corners = mesh.indices[p.triangle as usize];
+                    let [v0, v1, v2] = corners.map(|v| mesh.positions[v as usize]);
+                    primitive.v0 = v0.to_array();
+                    primitive.e1 = (v1 - v0).to_array();
+                    primitive.e2 = (v2 - v0).to_array();
+                }
+                primitive
+            })
+            .collect();
+    }
+}
+
+/// World-space bounds of a shape, grown slightly so flat shapes have volume.
+fn shape_bounds(shape: &Shape) -> Aabb {
+    let (min, max) = match *shape {
+        Shape::Quad {
+            origin,
+            edge_u,
+            edge_v,
+        } => {
+            let corners = [
+                origin,
+                origin + edge_u,
+                origin + edge_v,
+                origin + edge_u + edge_v,
+            ];
+            let min = corners.iter().copied().reduce(Vec3::min).unwrap_or(origin);
+            let max = corners.iter().copied().reduce(Vec3::max).unwrap_or(origin);
+            (min, max)
+        }
+        Shape::Sphere { center, radius, .. } => (center - radius, center + radius),
+        Shape::Cylinder { p0, p1, radius, .. } => {
+            // Bounds of the two end disks: per axis, radius * sqrt(1 - axis_i^2).
+            let axis = (p1 - p0).normalize();
+            let extent = radius * (Vec3::ONE - axis * axis).max(Vec3::ZERO).powf(0.5);
+            (p0.min(p1) - extent, p0.max(p1) + extent)
+        }
+        Shape::Mesh(ref mesh) => {
+            let min = mesh.positions.iter().copied().fold(Vec3::MAX, Vec3::min);
+            let max = mesh.positions.iter().copied().fold(Vec3::MIN, Vec3::max);
+            (min, max)
+        }
+    };
+    let pad = (max - min).max_element() * 1e-5 + 1e-6;
+    Aabb {
+        min: Vec3A::from(min - pad),
+        max: Vec3A::from(max + pad),
+    }
+}
+
+/// An object's shape; a mesh's triangle range is set by [`Geometry::lay_out_primitives`].
+fn gpu_shape(shape: &Shape, bounds: &Aabb) -> GpuObject {
+    let mut o = GpuObject {
+        light: NO_LIGHT,
+        ..GpuObject::zeroed()
+    };
+    match *shape {
+        Shape::Quad {
+            origin,
+            edge_u,
+            edge_v,
+        } => {
+            o.kind = KIND_QUAD;
+            o.a = origin.extend(0.0).to_array();
+            o.b = edge_u.extend(0.0).to_array();
+            o.c = edge_v.extend(0.0).to_array();
+        }
+        Shape::Sphere {
+            center,
+            radius,
+            texture_rotation,
+        } => {
+            o.kind = KIND_SPHERE;
+            o.a = center.extend(radius).to_array();
+            o.b = [texture_rotation, 0.0, 0.0, 0.0];
+        }
+        Shape::Cylinder {
+            p0,
+            p1,
+            radius,
+            caps,
+        } => {
+            o.kind = KIND_CYLINDER;
+            o.a = p0.extend(radius).to_array();
+            o.b = p1.extend(0.0).to_array();
+            if caps {
+                o.flags |= FLAG_CAPS;
+            }
+        }
+        Shape::Mesh(ref mesh) => {
+            o.kind = KIND_MESH;
+            o.a = Vec3::from(bounds.min).extend(0.0).to_array();
+            o.b = Vec3::from(bounds.max).extend(0.0).to_array();
+            if mesh.flat {
+                o.flags |= FLAG_FLAT;
+            }
+        }
+    }
+    o
+}
+
+/// Box around triangle `t` of `mesh`.
+fn triangle_bounds(mesh: &TriangleMesh, t: usize) -> Aabb {
+    let [v0, v1, v2] = mesh.indices[t].map(|i| Vec3A::from(mesh.positions[i as usize]));
+    Aabb {
+        min: v0.min(v1).min(v2),
+        max: v0.max(v1).max(v2),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+    use pathlight_scene::testing::{mesh_of, object, random_mesh, random_objects, scene_of};
+    use pathlight_scene::{Object, Shape};
+    use rand::SeedableRng;
+    use rand::rngs::StdRng;
+
+    use super::Geometry;
+    use crate::bvh::lane_used;
+    use crate::gpu_types::{GpuWideNode, KIND_MESH, NO_TRIANGLE, SHAPE_LEAF};
+
+    /// Whether box `lane` of `node` holds the box from `min` to `max` (with a margin).
+    fn contains(node: &GpuWideNode, lane: usize, min: Vec3, max: Vec3) -> bool {
+        let lo = Vec3::new(node.lo_x[lane], node.lo_y[lane], node.lo_z[lane]);
+        let hi = Vec3::new(node.hi_x[lane], node.hi_y[lane], node.hi_z[lane]);
+        lo.cmple(min + 1e-4).all() && hi.cmpge(max - 1e-4).all()
+    }
+
+    /// The box around the used lanes of node `index`.
+    fn node_bounds(g: &Geometry, index: u32) -> (Vec3, Vec3) {
+        let n = &g.nodes[index as usize];
+        (0..4).filter(|&lane| lane_used(n, lane)).fold(
+            (Vec3::MAX, Vec3::MIN),
+            |(min, max), lane| {
+                let lo = Vec3::new(n.lo_x[lane], n.lo_y[lane], n.lo_z[lane]);
+                let hi = Vec3::new(n.hi_x[lane], n.hi_y[lane], n.hi_z[lane]);
+                (min.min(lo), max.max(hi))
+            },
+        )
+    }
+
+    /// Every child box holds its node's or its leaf's contents; every node is reached once;
+    /// every primitive is in exactly one leaf, marked SHAPE_LEAF exactly when it holds a
+    /// shape; every shape and every mesh triangle is exactly one primitive, a triangle one
+    /// with the vertex buffer's corners and its mesh's triangle range.
+    fn validate(g: &Geometry) {
+        let mut seen = Vec::new();
+        let mut nodes_seen = vec![0u32; g.nodes.len()];
+        let mut stack = vec![0u32];
+        while let Some(index) = stack.pop() {
+            nodes_seen[index as usize] += 1;
+            let n = g.nodes[index as usize];
+            for lane in (0..4).filter(|&lane| lane_used(&n, lane)) {
+                let count = n.count[lane] & !SHAPE_LEAF;
+                if count == 0 {
+                    let (min, max) = node_bounds(g, n.first[lane]);
+                    assert!(contains(&n, lane, min, max), "node {index} lane {lane}");
+                    stack.push(n.first[lane]);
+                    continue;
+                }
+                let primitives = n.first[lane]..n.first[lane] + count;
+                let holds_shape = primitives
+                    .clone()
+                    .any(|p| g.primitives[p as usize].triangle == NO_TRIANGLE);
+                assert_eq!(n.count[lane] & SHAPE_LEAF != 0, holds_shape, "SHAPE_LEAF");
+                for p in primitives {
+                    let prim = g.primitives[p as usize];
+                    let owner = g.shapes[prim.object as usize];
+                    if prim.triangle == NO_TRIANGLE {
+                        assert_ne!(owner.kind, KIND_MESH, "primitive {p}: a mesh as a shape");
+                    } else {
+                        let tri = prim.triangle;
+                        let range =
+                            owner.first_triangle..owner.first_triangle + owner.triangle_count;
+                        assert!(
+                            owner.kind == KIND_MESH && range.contains(&tri),
+                            "triangle {tri}"
+                        );
+                        let [v0, v1, v2] = g.triangle(tri);
+                        assert_eq!(
+                            [prim.v0, prim.e1, prim.e2],
+                            [v0, v1 - v0, v2 - v0].map(|v| v.to_array()),
+                            "primitive {p}: not triangle {tri}'s corner and edges"
+                        );
+                        for v in [v0, v1, v2] {
+                            assert!(contains(&n, lane, v, v), "triangle {tri} escapes its leaf");
+                        }
+                    }
+                    seen.push(p);
+                }
+            }
+        }
+        if !g.primitives.is_empty() {
+            assert!(
+                nodes_seen.iter().all(|&n| n == 1),
+                "every node reached once"
+            );
+        }
+        seen.sort_unstable();
+        assert_eq!(seen, (0..g.primitives.len() as u32).collect::<Vec<_>>());
+        let mut shapes: Vec<u32> = g
+            .primitives
+            .iter()
+            .filter(|p| p.triangle == NO_TRIANGLE)
+            .map(|p| p.object)
+            .collect();
+        shapes.sort_unstable();
+        let expected: Vec<u32> = (0..g.shapes.len() as u32)
+            .filter(|&i| g.shapes[i as usize].kind != KIND_MESH)
+            .collect();
+        assert_eq!(shapes, expected, "every shape is one primitive");
+        let mut triangles: Vec<u32> = g
+            .primitives
+            .iter()
+            .filter(|p| p.triangle != NO_TRIANGLE)
+            .map(|p| p.triangle)
+            .collect();
+        triangles.sort_unstable();
+        assert_eq!(
+            triangles,
+            (0..g.triangle_count() as u32).collect::<Vec<_>>(),
+            "every triangle is one primitive"
+        );
+    }
+
+    #[test]
+    fn random_scenes_build_valid_trees() {
+        let mut rng = StdRng::seed_from_u64(7);
+        for count in [1, 2, 5, 40] {
+            validate(&Geometry::build(&random_objects(&mut rng, count)));
+        }
+        let big = vec![object(
+            "big",
+            Shape::Mesh(random_mesh(&mut rng, 20_000, Vec3::ZERO)),
+        )];
+        validate(&Geometry::build(&big));
+    }
+
+    #[test]
+    fn an_empty_scene_has_one_node_that_no_ray_enters() {
+        let g = Geometry::build(&[]);
+        validate(&g);
+        assert_eq!(g.nodes.len(), 1);
+        assert!((0..4).all(|lane| !lane_used(&g.nodes[0], lane)));
+        assert_eq!(g.stack_bound, 1);
+        assert_eq!(
+            g.vertices.len(),
+            1,
+            "a placeholder vertex keeps the buffer bindable"
+        );
+    }
+
+    #[test]
+    fn degenerate_and_coincident_triangles_build_valid_trees() {
+        let degenerate = mesh_of(&[
+            [Vec3::ZERO, Vec3::X, Vec3::X * 2.0],
+            [Vec3::Y, Vec3::Y, Vec3::Z],
+            [
+                Vec3::new(-1.0, -1.0, 0.0),
+                Vec3::new(1.0, -1.0, 0.0),
+                Vec3::Y,
+            ],
+        ]);
+        let flat = Shape::Quad {
+            origin: Vec3::new(-1.0, -1.0, -2.0),
+            edge_u: Vec3::X * 2.0,
+            edge_v: Vec3::Y * 2.0,
+        };
+        validate(&Geometry::build(&[
+            object("mesh", Shape::Mesh(degenerate)),
+            object("flat quad", flat),
+        ]));
+        // 5,000 copies of one triangle: no centroid splits them, whatever depth the build makes.
+        let copies = vec![[Vec3::new(-1.0, -1.0, 0.0), Vec3::X, Vec3::Y]; 5000];
+        validate(&Geometry::build(&[object(
+            "stack",
+            Shape::Mesh(mesh_of(&copies)),
+        )]));
+    }
+
+    #[test]
+    fn the_build_does_not_depend_on_the_thread_count() {
+        // obvhs' build and the buffer fill run on rayon: one thread and four give the same
+        // tree and buffers, so a seeded render is the same image on any machine.
+        let mut rng = StdRng::seed_from_u64(13);
+        let mut objects: Vec<Object> = random_objects(&mut rng, 40);
+        objects.push(object(
+            "big",
+            Shape::Mesh(random_mesh(&mut rng, 30_000, Vec3::ZERO)),
+        ));
+        let scene = scene_of(objects);
+        let build_on = |threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a thread pool")
+                .install(|| Geometry::build(&scene.objects))
+        };
+        let (one, four) = (build_on(1), build_on(4));
+        validate(&four);
+        let bytes = |g: &Geometry| {
+            [
+                bytemuck::cast_slice::<_, u8>(&g.nodes).to_vec(),
+                bytemuck::cast_slice(&g.primitives).to_vec(),
+                bytemuck::cast_slice(&g.vertices).to_vec(),
+                bytemuck::cast_slice(&g.shapes).to_vec(),
+            ]
+        };
+        assert!(bytes(&one) == bytes(&four), "the buffers differ");
+    }
+}

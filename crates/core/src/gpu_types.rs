@@ -1,0 +1,284 @@
+//! Every host struct that WGSL also declares (in `crates/render/shaders/scene.wgsl`,
+//! `camera.wgsl` and `integrator.wgsl`; each declaration names its host struct here).
+//!
+//! Every struct is `#[repr(C)]` + `Pod`, uses no `vec3` without the scalar that pads it to
+//! 16 bytes, and is pinned in size here and in field offsets by a naga test in
+//! `crates/render/tests/shaders.rs`.
+
+use bytemuck::{Pod, Zeroable};
+
+/// [`GpuObject::kind`] of a parallelogram.
+pub const KIND_QUAD: u32 = 0;
+/// [`GpuObject::kind`] of a sphere.
+pub const KIND_SPHERE: u32 = 1;
+/// [`GpuObject::kind`] of a cylinder.
+pub const KIND_CYLINDER: u32 = 2;
+/// [`GpuObject::kind`] of a triangle mesh.
+pub const KIND_MESH: u32 = 3;
+
+/// [`GpuObject::light`] of an object that does not emit.
+pub const NO_LIGHT: u32 = u32::MAX;
+
+/// [`GpuRenderParams::sampler`]: padded Owen-scrambled Sobol.
+pub const SAMPLER_SOBOL: u32 = 0;
+/// [`GpuRenderParams::sampler`]: independent hashed random numbers.
+pub const SAMPLER_INDEPENDENT: u32 = 1;
+
+/// [`GpuObject::flags`] bit: shade a mesh with geometric normals.
+pub const FLAG_FLAT: u32 = 1;
+/// [`GpuObject::flags`] bit: a cylinder closed by two disks.
+pub const FLAG_CAPS: u32 = 2;
+
+/// One object of the scene, in the scene's order. WGSL: `Object`.
+///
+/// Geometry by kind: quad `a` = origin, `b` = edge_u, `c` = edge_v; sphere `a.xyz` = centre,
+/// `a.w` = radius, `b.x` = texture rotation (radians); cylinder `a.xyz` = p0, `a.w` = radius,
+/// `b.xyz` = p1; mesh: its triangles `first_triangle ..` in the vertex buffer, and the box
+/// around them from `a.xyz` to `b.xyz` (for the seed's bounding-volume scheme).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuObject {
+    /// First geometry vector.
+    pub a: [f32; 4],
+    /// Second geometry vector.
+    pub b: [f32; 4],
+    /// Third geometry vector.
+    pub c: [f32; 4],
+    /// `KIND_*`.
+    pub kind: u32,
+    /// Index into the material buffer.
+    pub material: u32,
+    /// `FLAG_*` bits.
+    pub flags: u32,
+    /// Its first entry in the light table, or [`NO_LIGHT`]. A mesh has one entry per
+    /// triangle: triangle `t` is entry `light + t - first_triangle`.
+    pub light: u32,
+    /// Mesh only: index of its first triangle in the vertex buffer (in triangles).
+    pub first_triangle: u32,
+    /// Mesh only: number of its triangles (`first_triangle ..` in the vertex buffer).
+    pub triangle_count: u32,
+    /// Padding to 16 bytes.
+    pub pad: [u32; 2],
+}
+const _: () = assert!(size_of::<GpuObject>() == 80);
+
+/// One emitter a path can sample: a whole quad, sphere or cylinder, or one triangle of an
+/// emissive mesh, chosen with probability proportional to its power. WGSL: `Light`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuLight {
+    /// Index into the object buffer.
+    pub object: u32,
+    /// Triangle index for a mesh light, 0 otherwise.
+    pub primitive: u32,
+    /// Probability of choosing a light up to and including this one (among the shape
+    /// lights; the environment is chosen first with `env_pmf`).
+    pub cdf: f32,
+    /// Probability of choosing this light among the shape lights.
+    pub pmf: f32,
+}
+const _: () = assert!(size_of::<GpuLight>() == 16);
+
+/// One node of the 4-wide BVH both backends walk ([`crate::geometry::Geometry::nodes`]): its
+/// four children's boxes in structure-of-arrays form, and what each child is. Aligned to 16
+/// bytes so that the CPU loads each row of four as one SIMD register. WGSL: `WideNode`.
+#[repr(C, align(16))]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuWideNode {
+    /// The children's minimum x coordinates; an unused child has an inverted box
+    /// (+inf to -inf) that no ray enters.
+    pub lo_x: [f32; 4],
+    /// The children's minimum y coordinates.
+    pub lo_y: [f32; 4],
+    /// The children's minimum z coordinates.
+    pub lo_z: [f32; 4],
+    /// The children's maximum x coordinates.
+    pub hi_x: [f32; 4],
+    /// The children's maximum y coordinates.
+    pub hi_y: [f32; 4],
+    /// The children's maximum z coordinates.
+    pub hi_z: [f32; 4],
+    /// Per child: an inner node's index, or a leaf's first primitive.
+    pub first: [u32; 4],
+    /// Per child: a leaf's number of primitives, with [`SHAPE_LEAF`] set when any of them
+    /// is not a triangle; 0 for an inner node or an unused child.
+    pub count: [u32; 4],
+}
+const _: () = assert!(size_of::<GpuWideNode>() == 128);
+
+/// [`GpuWideNode::count`] bit: the leaf holds a shape (not only triangles), and the GPU tests
+/// it as soon as it enters the box instead of pushing it.
+pub const SHAPE_LEAF: u32 = 1 << 31;
+
+/// One triangle corner. WGSL: `Vertex`; a triangle is three consecutive vertices.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuVertex {
+    /// World position.
+    pub position: [f32; 3],
+    /// Texture coordinate u.
+    pub u: f32,
+    /// Shading normal (unit).
+    pub normal: [f32; 3],
+    /// Texture coordinate v.
+    pub v: f32,
+}
+const _: () = assert!(size_of::<GpuVertex>() == 32);
+
+/// [`GpuPrimitive::triangle`] of a quad, sphere or cylinder.
+pub const NO_TRIANGLE: u32 = u32::MAX;
+
+/// One primitive of the BVH, in leaf order: a triangle in the form the intersection test
+/// wants (its first corner and the two edges from it) or a whole analytic shape. WGSL:
+/// `Primitive`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuPrimitive {
+    /// Triangle: corner 0.
+    pub v0: [f32; 3],
+    /// The object it belongs to (index into the object buffer).
+    pub object: u32,
+    /// Triangle: corner 1 minus corner 0.
+    pub e1: [f32; 3],
+    /// The triangle's index in the vertex buffer, or [`NO_TRIANGLE`] for a shape.
+    pub triangle: u32,
+    /// Triangle: corner 2 minus corner 0.
+    pub e2: [f32; 3],
+    /// Padding.
+    pub pad: u32,
+}
+const _: () = assert!(size_of::<GpuPrimitive>() == 48);
+
+/// A material in linear RGB. WGSL: `Material`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuMaterial {
+    /// Base colour.
+    pub base_color: [f32; 3],
+    /// Index into the texture table, or -1.
+    pub texture: i32,
+    /// Emitted radiance (front side).
+    pub emission: [f32; 3],
+    /// Weight of the specular lobe.
+    pub specular_rate: f32,
+    /// Conductor IOR, real part (when `conductor` is 1).
+    pub eta: [f32; 3],
+    /// Specular colour between white and base colour.
+    pub specular_tint: f32,
+    /// Conductor IOR, imaginary part (when `conductor` is 1).
+    pub k: [f32; 3],
+    /// Roughness of the specular lobe.
+    pub specular_roughness: f32,
+    /// Weight of the transmission lobe.
+    pub refract_rate: f32,
+    /// Transmitted colour between white and base colour.
+    pub refract_tint: f32,
+    /// Index of refraction of the inside.
+    pub ior: f32,
+    /// Roughness of transmission.
+    pub refract_roughness: f32,
+    /// 1: the specular lobe uses the complex-IOR conductor Fresnel; 0: Schlick.
+    pub conductor: u32,
+    /// Padding to 16 bytes.
+    pub pad: [u32; 3],
+}
+const _: () = assert!(size_of::<GpuMaterial>() == 96);
+
+/// Where a texture's texels lie in the texel buffer. WGSL: `TextureInfo`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuTextureInfo {
+    /// First texel.
+    pub offset: u32,
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Padding.
+    pub pad: u32,
+}
+const _: () = assert!(size_of::<GpuTextureInfo>() == 16);
+
+/// The camera as the integrator reads it: the eye and the image plane at unit distance.
+/// WGSL: `CameraParams`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuCamera {
+    /// Eye position.
+    pub position: [f32; 3],
+    /// Padding.
+    pub pad0: u32,
+    /// Unit view direction.
+    pub forward: [f32; 3],
+    /// Padding.
+    pub pad1: u32,
+    /// Right vector scaled to half the image width at unit distance.
+    pub right: [f32; 3],
+    /// Padding.
+    pub pad2: u32,
+    /// Up vector scaled to half the image height at unit distance.
+    pub up: [f32; 3],
+    /// Padding.
+    pub pad3: u32,
+}
+const _: () = assert!(size_of::<GpuCamera>() == 64);
+
+/// Per-dispatch constants of the integrator: the camera, the image, the settings and the
+/// light selection. WGSL: `RenderParams`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuRenderParams {
+    /// The camera.
+    pub camera: GpuCamera,
+    /// Constant environment radiance.
+    pub environment: [f32; 3],
+    /// Probability of sampling the environment rather than a shape light.
+    pub env_pmf: f32,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel already accumulated before this dispatch.
+    pub sample_offset: u32,
+    /// Samples per pixel this dispatch adds.
+    pub batch_samples: u32,
+    /// First row this dispatch covers (long renders are split into row bands).
+    pub row_offset: u32,
+    /// End (exclusive) of the row band this dispatch covers.
+    pub row_end: u32,
+    /// Maximum path length in segments.
+    pub max_depth: u32,
+    /// Depth from which Russian roulette applies.
+    pub rr_depth: u32,
+    /// Seed of the random sequence.
+    pub seed: u32,
+    /// `SAMPLER_*`.
+    pub sampler: u32,
+    /// Number of objects.
+    pub object_count: u32,
+    /// Number of entries in the light table.
+    pub light_count: u32,
+}
+const _: () = assert!(size_of::<GpuRenderParams>() == 128);
+
+/// One pixel of the accumulation buffer. WGSL: `AccumPixel`.
+///
+/// Per RGB channel the running sum of samples is the 64-bit fixed-point number
+/// `hi + lo / 2^32`, added with integer carries on the GPU, so it is exact and merges
+/// exactly; the fourth lane is unused.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuAccumPixel {
+    /// Integer part of the sum.
+    pub hi: [u32; 4],
+    /// Fraction of the sum, in units of 2^-32.
+    pub lo: [u32; 4],
+}
+
+impl GpuAccumPixel {
+    /// The sum of channel `c` as a float.
+    pub fn channel_sum(&self, c: usize) -> f64 {
+        f64::from(self.hi[c]) + f64::from(self.lo[c]) / 4_294_967_296.0
+    }
+}
+const _: () = assert!(size_of::<GpuAccumPixel>() == 32);

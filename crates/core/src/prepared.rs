@@ -1,0 +1,42 @@
+//! A scene prepared once for rendering and shared by both backends.
+
+use std::sync::Arc;
+
+use pathlight_scene::Scene;
+
+use crate::geometry::Geometry;
+use crate::shading::Shading;
+use crate::textures::Textures;
+
+/// Everything a backend needs of a scene but the camera and the settings: its geometry
+/// and BVH and its textures (built once, shared), and its shading (rebuilt when materials
+/// change). Cloning is cheap: the large parts are shared.
+#[derive(Debug, Clone)]
+pub struct PreparedScene {
+    /// Shapes, triangles and the BVH.
+    pub geometry: Arc<Geometry>,
+    /// Texels.
+    pub textures: Arc<Textures>,
+    /// Materials, lights, environment.
+    pub shading: Shading,
+}
+
+impl PreparedScene {
+    /// Builds the BVH and the buffers of `scene`.
+    pub fn new(scene: &Scene) -> Self {
+        let geometry = Geometry::build(&scene.objects);
+        let shading = Shading::build(scene, &geometry);
+        Self {
+            geometry: Arc::new(geometry),
+            textures: Arc::new(Textures::build(&scene.textures)),
+            shading,
+        }
+    }
+
+    /// The shading of `scene`, whose objects must be this scene's (only their materials,
+    /// the materials themselves and the environment may differ). Textures are kept: a
+    /// material may only use the textures the scene was prepared with.
+    pub fn shading_of(&self, scene: &Scene) -> Shading {
+        Shading::build(scene, &self.geometry)
+    }
+}

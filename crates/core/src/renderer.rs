@@ -1,0 +1,63 @@
+//! The one interface of both backends: a progressive render of a prepared scene that the
+//! commands (`render`, `bench`, the viewer) drive the same way on either.
+
+use std::time::Duration;
+
+use pathlight_scene::Camera;
+
+use crate::error::RenderError;
+use crate::film::Film;
+use crate::shading::Shading;
+
+/// A progressive render: samples are added to every pixel in turn, and the image at any
+/// moment is the mean of the samples so far. Sample `i` of a pixel is the same whatever
+/// batches the work was split into, so the image depends only on the sample count.
+pub trait Renderer {
+    /// Where it renders, for messages and reports (the adapter, or the CPU and its threads).
+    fn device(&self) -> String;
+
+    /// Image width and height in pixels.
+    fn size(&self) -> (u32, u32);
+
+    /// Moves the camera (and resizes the image to the camera's) and restarts. Only the
+    /// per-render constants change: the scene stays where it is.
+    fn set_camera(&mut self, camera: &Camera) -> Result<(), RenderError>;
+
+    /// Replaces the materials, lights and environment (a light toggle) and restarts. The
+    /// geometry and the BVH stay.
+    fn set_materials(&mut self, shading: &Shading) -> Result<(), RenderError>;
+
+    /// Empties the image and the ray count: the next sample is sample 0 again.
+    fn restart(&mut self);
+
+    /// Adds up to `max_samples` samples per pixel to every pixel (at least one when
+    /// `max_samples` > 0) in a batch of a fraction of a second; returns how many.
+    fn advance(&mut self, max_samples: u32) -> Result<u32, RenderError>;
+
+    /// Renders the next part of the current frame (one sample per pixel), taking about
+    /// `target`; returns whether the frame is complete. A frame in progress shows in
+    /// [`Self::film`] exactly (its finished pixels hold one sample more).
+    fn step_frame(&mut self, target: Duration) -> Result<bool, RenderError>;
+
+    /// Queues one frame (one sample per pixel) as one unit of work, without waiting for it
+    /// where the device works asynchronously; [`Self::finish`] waits.
+    fn queue_frame(&mut self) -> Result<(), RenderError>;
+
+    /// Waits until every queued frame has finished.
+    fn finish(&self) -> Result<(), RenderError>;
+
+    /// Whole samples per pixel accumulated so far.
+    fn samples_done(&self) -> u32;
+
+    /// Rays traced (camera, extension and shadow rays) since the start or the last restart.
+    fn rays_traced(&self) -> Result<u64, RenderError>;
+
+    /// The mean of the samples so far.
+    fn film(&self) -> Result<Film, RenderError>;
+
+    /// Entries of the traversal stack the GPU integrator is compiled with; `None` where the
+    /// stack grows as needed (the CPU backend).
+    fn traversal_stack(&self) -> Option<u32> {
+        None
+    }
+}

@@ -1,0 +1,494 @@
+//! The BVH walk of one ray: an ordered depth-first walk of the 4-wide tree with one
+//! explicit stack. Twin of `bvh.wgsl` (its primitive tests are the same functions, so the
+//! hits are the same; only the order of the walk differs, which can change the answer
+//! between two primitives at exactly the same distance). [`crate::packet`] walks packets
+//! of rays through the same tree.
+
+use glam::{Vec3, Vec4};
+use pathlight_core::gpu_types::{
+    FLAG_CAPS, GpuWideNode, KIND_QUAD, KIND_SPHERE, NO_TRIANGLE, SHAPE_LEAF,
+};
+
+use crate::cpu_scene::CpuScene;
+use crate::intersect::{
+    Ray, intersect_cylinder, intersect_quad, intersect_sphere, intersect_triangle_edges,
+    safe_inverse,
+};
+use crate::packet::Lanes;
+
+/// The nearest hit of a ray. Twin of WGSL `Hit`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    /// Distance along the ray.
+    pub t: f32,
+    /// Index into the objects (the scene's order).
+    pub object: u32,
+    /// Mesh: triangle index; other shapes: 0.
+    pub primitive: u32,
+    /// Triangle: barycentric of vertex 1; quad: s.
+    pub b1: f32,
+    /// Triangle: barycentric of vertex 2; quad: t.
+    pub b2: f32,
+}
+
+impl Hit {
+    /// No hit yet: a search up to `t_max` (`object` is `u32::MAX` until something is hit).
+    pub fn none(t_max: f32) -> Self {
+        Self {
+            t: t_max,
+            object: u32::MAX,
+            primitive: 0,
+            b1: 0.0,
+            b2: 0.0,
+        }
+    }
+}
+
+/// A node still to visit, and the distance at which the ray enters its box.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Entry {
+    node: u32,
+    t: f32,
+}
+
+/// The ray in the form the box tests want: its origin and inverse direction splatted across
+/// lanes, and per axis whether it runs backwards (so the maximum planes are the near ones).
+pub(crate) struct RayLanes {
+    origin: [Vec4; 3],
+    inv_dir: [Vec4; 3],
+    backwards: [bool; 3],
+}
+
+impl RayLanes {
+    #[inline(always)]
+    pub(crate) fn new(ray: &Ray) -> Self {
+        let inv = safe_inverse(ray.dir);
+        Self {
+            origin: [
+                Vec4::splat(ray.origin.x),
+                Vec4::splat(ray.origin.y),
+                Vec4::splat(ray.origin.z),
+            ],
+            inv_dir: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
+            backwards: [inv.x < 0.0, inv.y < 0.0, inv.z < 0.0],
+        }
+    }
+
+    /// Entry distances of the four child boxes of `node` (clamped at 0) and the bit mask of
+    /// those the ray enters before `t_max`. Per lane the same products as the WGSL slab
+    /// test, with the min/max of each pair chosen by the direction's sign. Twin of WGSL
+    /// `enter_children`.
+    #[inline(always)]
+    fn enter(&self, node: &GpuWideNode, t_max: f32) -> (Vec4, u32) {
+        let lo = [node.lo_x, node.lo_y, node.lo_z].map(Vec4::from_array);
+        let hi = [node.hi_x, node.hi_y, node.hi_z].map(Vec4::from_array);
+        let mut t_near = Vec4::ZERO;
+        let mut t_far = Vec4::splat(t_max);
+        for axis in 0..3 {
+            let (near, far) = if self.backwards[axis] {
+                (hi[axis], lo[axis])
+            } else {
+                (lo[axis], hi[axis])
+            };
+            let (o, inv) = (self.origin[axis], self.inv_dir[axis]);
+            t_near = t_near.max((near - o) * inv);
+            t_far = t_far.min((far - o) * inv);
+        }
+        (t_near, t_near.cmple(t_far).bitmask())
+    }
+}
+
+impl CpuScene<'_> {
+    /// Nearest hit on quad, sphere or cylinder object `i`, updating `hit`; Twin of WGSL
+    /// `intersect_shape`.
+    #[inline(always)]
+    pub fn intersect_shape(&self, i: u32, ray: &Ray, hit: &mut Hit) {
+        let o = &self.objects[i as usize];
+        let a = Vec3::from_slice(&o.a);
+        let (t, b1, b2) = match o.kind {
+            KIND_QUAD => intersect_quad(
+                a,
+                Vec3::from_slice(&o.b),
+                Vec3::from_slice(&o.c),
+                ray,
+                hit.t,
+            ),
+            KIND_SPHERE => (intersect_sphere(a, o.a[3], ray, hit.t), 0.0, 0.0),
+            _ => {
+                let caps = o.flags & FLAG_CAPS != 0;
+                let t = intersect_cylinder(a, Vec3::from_slice(&o.b), o.a[3], caps, ray, hit.t);
+                (t, 0.0, 0.0)
+            }
+        };
+        if t < hit.t {
+            *hit = Hit {
+                t,
+                object: i,
+                primitive: 0,
+                b1,
+                b2,
+            };
+        }
+    }
+
+    /// Nearest hit on primitive `i` (a shape or a triangle), updating `hit`; Twin of WGSL
+    /// `intersect_primitive`.
+    #[inline(always)]
+    pub fn intersect_primitive(&self, i: u32, ray: &Ray, hit: &mut Hit) {
+        let p = &self.primitives[i as usize];
+        if p.triangle == NO_TRIANGLE {
+            self.intersect_shape(p.object, ray, hit);
+            return;
+        }
+        let [v0, e1, e2] = [p.v0, p.e1, p.e2].map(Vec3::from);
+        let (t, b1, b2) = intersect_triangle_edges(v0, e1, e2, ray, hit.t);
+        if t < hit.t {
+            *hit = Hit {
+                t,
+                object: p.object,
+                primitive: p.triangle,
+                b1,
+                b2,
+            };
+        }
+    }
+}
+
+/// Ray queries from one thread against a scene, one ray at a time or in
+/// packets ([`crate::packet`]). It keeps the traversal stacks that every query reuses, so
+/// that queries allocate nothing once they have grown to the tree's needs, and so that the
+/// whole walk inlines into the caller (compiled for its instruction set).
+#[derive(Debug, Clone)]
+pub struct Tracer<'a> {
+    /// The scene and its tree.
+    pub scene: &'a CpuScene<'a>,
+    /// The single-ray walk's stack.
+    pub(crate) stack: Vec<Entry>,
+    /// The packet walk's stack: nodes and the rays that entered them.
+    pub(crate) packet_stack: Vec<(u32, Lanes)>,
+}
+
+impl<'a> Tracer<'a> {
+    /// Queries against `scene`.
+    pub fn new(scene: &'a CpuScene<'a>) -> Self {
+        Self {
+            scene,
+            stack: Vec::new(),
+            packet_stack: Vec::new(),
+        }
+    }
+
+    /// Nearest hit in `(0, t_max)`.
+    #[inline(always)]
+    pub fn intersect(&mut self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let hit = self.trace(ray, t_max, false);
+        (hit.object != u32::MAX).then_some(hit)
+    }
+
+    /// Whether anything lies on the ray in `(0, t_max)`.
+    #[inline(always)]
+    pub fn occluded(&mut self, ray: &Ray, t_max: f32) -> bool {
+        self.trace(ray, t_max, true).object != u32::MAX
+    }
+
+    /// Nearest hit in `(0, t_max)`, or with `any_hit` the first one found. Twin of WGSL
+    /// `trace_scene`.
+    #[inline(always)]
+    fn trace(&mut self, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
+        let mut hit = Hit::none(t_max);
+        if !self.scene.primitives.is_empty() {
+            let lanes = RayLanes::new(ray);
+            self.stack.clear();
+            let walk = Walk {
+                scene: self.scene,
+                ray,
+                lanes: &lanes,
+                any_hit,
+            };
+            walk.tree(&mut self.stack, 0, &mut hit);
+        }
+        hit
+    }
+}
+
+/// One ray query in progress.
+pub(crate) struct Walk<'a> {
+    pub scene: &'a CpuScene<'a>,
+    pub ray: &'a Ray,
+    pub lanes: &'a RayLanes,
+    pub any_hit: bool,
+}
+
+impl Walk<'_> {
+    /// Walks the subtree at `root`, nearest boxes first, using `stack` above its
+    /// current length. A node's entered leaves are tested as it is visited (nearest first);
+    /// inner nodes are pushed. An any-hit query stops at its first hit.
+    #[inline(always)]
+    pub(crate) fn tree(&self, stack: &mut Vec<Entry>, root: u32, hit: &mut Hit) {
+        let base = stack.len();
+        let mut node = root;
+        loop {
+            let n = &self.scene.nodes[node as usize];
+            let (t_near, mut mask) = self.lanes.enter(n, hit.t);
+            // The entered children, nearest first.
+            let mut order = [(0.0f32, 0usize); 4];
+            let mut entered = 0;
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let t = t_near[lane];
+                let mut k = entered;
+                while k > 0 && order[k - 1].0 > t {
+                    order[k] = order[k - 1];
+                    k -= 1;
+                }
+                order[k] = (t, lane);
+                entered += 1;
+            }
+            for &(t, lane) in &order[..entered] {
+                let count = n.count[lane] & !SHAPE_LEAF;
+                if count > 0 && t < hit.t {
+                    for i in n.first[lane]..n.first[lane] + count {
+                        self.scene.intersect_primitive(i, self.ray, hit);
+                    }
+                    if self.any_hit && hit.object != u32::MAX {
+                        return;
+                    }
+                }
+            }
+            for &(t, lane) in order[..entered].iter().rev() {
+                if n.count[lane] == 0 {
+                    stack.push(Entry {
+                        node: n.first[lane],
+                        t,
+                    });
+                }
+            }
+            loop {
+                if stack.len() == base {
+                    return;
+                }
+                let Some(entry) = stack.pop() else {
+                    return;
+                };
+                if entry.t < hit.t {
+                    node = entry.node;
+                    break;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use glam::Vec3;
+    use pathlight_core::PreparedScene;
+    use pathlight_core::bvh::lane_used;
+    use pathlight_core::gpu_types::KIND_MESH;
+    use pathlight_scene::testing::{
+        mesh_of, object, random_mesh, random_objects, random_point, scene_of,
+    };
+    use pathlight_scene::{Object, Shape};
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    use super::{Hit, Tracer};
+    use crate::cpu_scene::CpuScene;
+    use crate::intersect::{Ray, intersect_triangle_edges};
+
+    /// The scene of `objects`, prepared.
+    pub(crate) fn prepare(objects: Vec<Object>) -> PreparedScene {
+        PreparedScene::new(&scene_of(objects))
+    }
+
+    /// The nearest hit over every object and every triangle, without the BVH.
+    pub(crate) fn brute_force(scene: &CpuScene, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let mut hit = Hit::none(t_max);
+        for (i, o) in scene.objects.iter().enumerate() {
+            if o.kind != KIND_MESH {
+                // (A scene without objects holds a placeholder quad of no area.)
+                scene.intersect_shape(i as u32, ray, &mut hit);
+                continue;
+            }
+            for tri in o.first_triangle..o.first_triangle + o.triangle_count {
+                let [v0, v1, v2] = scene.triangle(tri);
+                let (t, b1, b2) = intersect_triangle_edges(v0, v1 - v0, v2 - v0, ray, hit.t);
+                if t < hit.t {
+                    hit = Hit {
+                        t,
+                        object: i as u32,
+                        primitive: tri,
+                        b1,
+                        b2,
+                    };
+                }
+            }
+        }
+        (hit.object != u32::MAX).then_some(hit)
+    }
+
+    /// A ray from anywhere in a 10-unit cube towards a point within `target` of the origin.
+    pub(crate) fn random_ray(rng: &mut StdRng, target: f32) -> Ray {
+        let origin = random_point(rng, 5.0);
+        Ray::new(
+            origin,
+            (random_point(rng, target) - origin).normalize_or(Vec3::X),
+        )
+    }
+
+    /// A ray towards a random point of the box around the scene's primitives.
+    pub(crate) fn ray_into_scene(rng: &mut StdRng, scene: &CpuScene) -> Ray {
+        let n = &scene.nodes[0];
+        let (min, max) = (0..4).filter(|&lane| lane_used(n, lane)).fold(
+            (Vec3::MAX, Vec3::MIN),
+            |(min, max), l| {
+                let lo = Vec3::new(n.lo_x[l], n.lo_y[l], n.lo_z[l]);
+                (
+                    min.min(lo),
+                    max.max(Vec3::new(n.hi_x[l], n.hi_y[l], n.hi_z[l])),
+                )
+            },
+        );
+        let target = min + (max - min) * Vec3::new(rng.random(), rng.random(), rng.random());
+        let origin = random_point(rng, 5.0);
+        Ray::new(origin, (target - origin).normalize_or(Vec3::X))
+    }
+
+    /// Checks a traversal (its nearest-hit and shadow queries) against brute force on
+    /// `rays`; returns how many rays hit something.
+    pub(crate) fn assert_like_brute_force(
+        scene: &CpuScene,
+        rays: &[Ray],
+        name: &str,
+        intersect: &mut dyn FnMut(&Ray, f32) -> Option<Hit>,
+        occluded: &mut dyn FnMut(&Ray, f32) -> bool,
+    ) -> usize {
+        let mut hits = 0;
+        for ray in rays {
+            let slow = brute_force(scene, ray, 1e30);
+            hits += usize::from(slow.is_some());
+            // The shadow query: blocked exactly when the nearest hit lies before t_max.
+            for t_max in [0.5, 2.0, 1e30] {
+                let blocked = slow.is_some_and(|h| h.t < t_max);
+                assert_eq!(
+                    occluded(ray, t_max),
+                    blocked,
+                    "{name}: ray {ray:?}, t_max {t_max}"
+                );
+            }
+            match (intersect(ray, 1e30), slow) {
+                (None, None) => {}
+                (Some(a), Some(b)) => {
+                    assert!(
+                        (a.t - b.t).abs() <= 1e-5 * b.t.max(1.0),
+                        "{name}: ray {ray:?}: bvh t {} vs brute force {}",
+                        a.t,
+                        b.t
+                    );
+                    if (a.t - b.t).abs() > 1e-7 * b.t {
+                        continue; // equal distances on two primitives: either answer is right
+                    }
+                    assert_eq!(a.object, b.object, "{name}: ray {ray:?}");
+                }
+                (a, b) => panic!("{name}: ray {ray:?}: bvh {a:?} vs brute force {b:?}"),
+            }
+        }
+        hits
+    }
+
+    /// The single-ray walk against brute force.
+    fn assert_walk(scene: &CpuScene, rays: &[Ray]) -> usize {
+        let tracer = std::cell::RefCell::new(Tracer::new(scene));
+        assert_like_brute_force(
+            scene,
+            rays,
+            "walk",
+            &mut |r, t| tracer.borrow_mut().intersect(r, t),
+            &mut |r, t| tracer.borrow_mut().occluded(r, t),
+        )
+    }
+
+    #[test]
+    fn the_walk_matches_brute_force_on_random_scenes() {
+        let mut rng = StdRng::seed_from_u64(7);
+        for count in [1, 2, 5, 40] {
+            let prepared = prepare(random_objects(&mut rng, count));
+            let scene = CpuScene::new(&prepared);
+            let rays: Vec<Ray> = (0..2000)
+                .map(|_| ray_into_scene(&mut rng, &scene))
+                .collect();
+            let hits = assert_walk(&scene, &rays);
+            assert!(hits > 20, "{count} objects: only {hits} of 2000 rays hit");
+        }
+        let prepared = prepare(vec![object(
+            "big",
+            Shape::Mesh(random_mesh(&mut rng, 20_000, Vec3::ZERO)),
+        )]);
+        let scene = CpuScene::new(&prepared);
+        let rays: Vec<Ray> = (0..300).map(|_| random_ray(&mut rng, 1.0)).collect();
+        assert!(assert_walk(&scene, &rays) > 50);
+    }
+
+    #[test]
+    fn an_empty_scene_has_no_hits() {
+        let prepared = prepare(Vec::new());
+        let scene = CpuScene::new(&prepared);
+        let mut tracer = Tracer::new(&scene);
+        let mut rng = StdRng::seed_from_u64(1);
+        for _ in 0..100 {
+            let ray = random_ray(&mut rng, 3.0);
+            assert_eq!(tracer.intersect(&ray, 1e30), None);
+            assert!(!tracer.occluded(&ray, 1e30));
+        }
+    }
+
+    #[test]
+    fn degenerate_triangles_coincident_triangles_and_axis_rays() {
+        let degenerate = mesh_of(&[
+            [Vec3::ZERO, Vec3::X, Vec3::X * 2.0],
+            [Vec3::Y, Vec3::Y, Vec3::Z],
+            [
+                Vec3::new(-1.0, -1.0, 0.0),
+                Vec3::new(1.0, -1.0, 0.0),
+                Vec3::Y,
+            ],
+        ]);
+        let flat = Shape::Quad {
+            origin: Vec3::new(-1.0, -1.0, -2.0),
+            edge_u: Vec3::X * 2.0,
+            edge_v: Vec3::Y * 2.0,
+        };
+        let prepared = prepare(vec![
+            object("mesh", Shape::Mesh(degenerate)),
+            object("flat", flat),
+        ]);
+        let scene = CpuScene::new(&prepared);
+        // Rays along the axes (zero direction components) through the flat boxes.
+        let mut rays = vec![
+            Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z),
+            Ray::new(Vec3::new(0.5, -0.5, 5.0), -Vec3::Z),
+            Ray::new(Vec3::new(5.0, 0.0, 0.0), -Vec3::X),
+            Ray::new(Vec3::new(0.0, 5.0, -2.0), -Vec3::Y),
+        ];
+        let mut rng = StdRng::seed_from_u64(3);
+        rays.extend((0..500).map(|_| random_ray(&mut rng, 1.0)));
+        assert!(assert_walk(&scene, &rays) >= 2);
+        let mut tracer = Tracer::new(&scene);
+        let hit = tracer
+            .intersect(&rays[0], 1e30)
+            .expect("the proper triangle is hit");
+        assert!((hit.t - 5.0).abs() < 1e-5);
+        assert_eq!(
+            tracer.intersect(&rays[0], 4.0),
+            None,
+            "t_max bounds the search"
+        );
+        // 5,000 copies of one triangle.
+        let copies = vec![[Vec3::new(-1.0, -1.0, 0.0), Vec3::X, Vec3::Y]; 5000];
+        let prepared = prepare(vec![object("stack", Shape::Mesh(mesh_of(&copies)))]);
+        let scene = CpuScene::new(&prepared);
+        let rays: Vec<Ray> = (0..200).map(|_| random_ray(&mut rng, 0.5)).collect();
+        assert!(assert_walk(&scene, &rays) > 20);
+    }
+}

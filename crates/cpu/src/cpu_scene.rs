@@ -1,0 +1,82 @@
+//! The prepared scene as the CPU backend reads it: the buffers the WGSL twin binds, as
+//! slices, and per object what shading would otherwise recompute on every hit and light
+//! sample.
+
+use glam::{Vec3, Vec3A};
+use pathlight_core::PreparedScene;
+use pathlight_core::gpu_types::{
+    GpuLight, GpuMaterial, GpuObject, GpuPrimitive, GpuTextureInfo, GpuVertex, GpuWideNode,
+    KIND_QUAD,
+};
+
+/// A view of a [`PreparedScene`] with the buffers of bind group 0 (`scene.wgsl`) side by
+/// side, and per object a quad's unit normal and area (the same values, bit for bit, as
+/// computing them where they are used).
+#[derive(Debug, Clone)]
+pub struct CpuScene<'a> {
+    /// The 4-wide BVH (WGSL `nodes`).
+    pub nodes: &'a [GpuWideNode],
+    /// The BVH's primitives in leaf order (WGSL `primitives`).
+    pub primitives: &'a [GpuPrimitive],
+    /// Triangle corners (WGSL `vertices`).
+    pub vertices: &'a [GpuVertex],
+    /// Objects with their materials (WGSL `objects`).
+    pub objects: &'a [GpuObject],
+    /// Materials (WGSL `materials`).
+    pub materials: &'a [GpuMaterial],
+    /// The light table (WGSL `lights`).
+    pub lights: &'a [GpuLight],
+    /// The texture table (WGSL `textures`).
+    pub textures: &'a [GpuTextureInfo],
+    /// Texels (WGSL `texels`).
+    pub texels: &'a [u32],
+    /// Per object: a quad's unit normal and area; zero for other kinds.
+    quads: Vec<(Vec3A, f32)>,
+}
+
+impl<'a> CpuScene<'a> {
+    /// The view of `scene`.
+    pub fn new(scene: &'a PreparedScene) -> Self {
+        let objects = &scene.shading.objects;
+        let quads = objects
+            .iter()
+            .map(|o| {
+                if o.kind != KIND_QUAD {
+                    return (Vec3A::ZERO, 0.0);
+                }
+                let normal = Vec3A::from_slice(&o.b).cross(Vec3A::from_slice(&o.c));
+                (normal.normalize(), normal.length())
+            })
+            .collect();
+        Self {
+            nodes: &scene.geometry.nodes,
+            primitives: &scene.geometry.primitives,
+            vertices: &scene.geometry.vertices,
+            objects,
+            materials: &scene.shading.materials,
+            lights: &scene.shading.lights,
+            textures: &scene.textures.infos,
+            texels: &scene.textures.texels,
+            quads,
+        }
+    }
+
+    /// The unit normal of quad `object` (the direction of `edge_u x edge_v`).
+    #[inline(always)]
+    pub fn quad_normal(&self, object: u32) -> Vec3A {
+        self.quads[object as usize].0
+    }
+
+    /// The area of quad `object`.
+    #[inline(always)]
+    pub fn quad_area(&self, object: u32) -> f32 {
+        self.quads[object as usize].1
+    }
+
+    /// Triangle `i`'s corner positions (`i` in triangles of the vertex buffer).
+    #[inline(always)]
+    pub fn triangle(&self, i: u32) -> [Vec3; 3] {
+        let i = 3 * i as usize;
+        [0, 1, 2].map(|k| Vec3::from(self.vertices[i + k].position))
+    }
+}

@@ -1,0 +1,493 @@
+//! The progressive renderer: owns the accumulation buffer and schedules the integrator.
+//!
+//! Work is submitted in pieces of about [`TARGET_SUBMISSION`] (a band of rows times some
+//! samples per pixel), sized from the measured speed, so no single submission trips a
+//! desktop GPU's watchdog and progress can be reported between them.
+
+use std::time::{Duration, Instant};
+
+use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams};
+use pathlight_core::{Film, PreparedScene, RenderError, Renderer, Shading};
+use pathlight_scene::{Camera, RenderSettings};
+
+use crate::context::{GpuContext, describe};
+use crate::pipeline::{bind_buffers, create_compute_pipeline, storage_entry};
+use crate::scene_buffers::SceneBuffers;
+use crate::wgsl;
+
+/// Aimed-for GPU time of one submission.
+pub const TARGET_SUBMISSION: Duration = Duration::from_millis(100);
+/// Most samples per pixel one dispatch adds.
+const MAX_BATCH_SAMPLES: u32 = 256;
+/// Workgroup edge of the integrator (`@workgroup_size(8, 8)`).
+const WORKGROUP: u32 = 8;
+
+/// How the integrator finds the nearest hit. Every scheme finds the same hit (a test checks
+/// it); the slower two reproduce the seed's frame-rate table (`pathlight bench --accel`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Accel {
+    /// The BVH over every shape and triangle.
+    #[default]
+    Bvh,
+    /// Every object in turn; a mesh's triangles only when the ray hits its bounding box.
+    BoundingVolume,
+    /// Every object and every triangle in turn.
+    BruteForce,
+}
+
+impl Accel {
+    /// All schemes, fastest first.
+    pub const ALL: [Accel; 3] = [Accel::Bvh, Accel::BoundingVolume, Accel::BruteForce];
+
+    /// Its name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Accel::Bvh => "bvh",
+            Accel::BoundingVolume => "bounding-volume",
+            Accel::BruteForce => "brute-force",
+        }
+    }
+
+    /// The shader's `ACCEL` pipeline constant selecting this scheme (`bvh.wgsl`).
+    pub fn pipeline_constants(self) -> [(&'static str, f64); 1] {
+        let value = match self {
+            Accel::Bvh => 0.0,
+            Accel::BoundingVolume => 1.0,
+            Accel::BruteForce => 2.0,
+        };
+        [("ACCEL", value)]
+    }
+}
+
+/// A progressive render on a wgpu adapter: the scene on the device, the integrator
+/// pipeline and the accumulation buffer.
+#[derive(Debug)]
+pub struct GpuRenderer {
+    /// The device (a cheap clone of the caller's context).
+    ctx: GpuContext,
+    scene: SceneBuffers,
+    pipeline: wgpu::ComputePipeline,
+    params_buffer: wgpu::Buffer,
+    accum_buffer: wgpu::Buffer,
+    /// Rays traced since the last restart (64-bit: low word, high word).
+    ray_counter: wgpu::Buffer,
+    frame_layout: wgpu::BindGroupLayout,
+    frame_bind_group: wgpu::BindGroup,
+    params: GpuRenderParams,
+    /// Rows of the frame in progress ([`Self::step_frame`]) that already hold its sample.
+    rows_ahead: u32,
+    /// Entries of the pipeline's traversal stack.
+    stack_size: u32,
+    /// Samples per pixel accumulated so far.
+    samples_done: u32,
+    /// Current piece size: rows per dispatch and samples per pixel per dispatch.
+    rows_per_dispatch: u32,
+    batch_samples: u32,
+    /// Whether the piece size follows the measured speed (see [`Self::set_piece`]).
+    adaptive: bool,
+}
+
+impl GpuRenderer {
+    /// Uploads `scene` and creates the pipeline for `camera` and `settings`, finding hits
+    /// with `accel`; the image starts empty.
+    pub fn new(
+        ctx: &GpuContext,
+        scene: &PreparedScene,
+        camera: &Camera,
+        settings: &RenderSettings,
+        accel: Accel,
+    ) -> Result<Self, RenderError> {
+        let device = &ctx.device;
+        let params = GpuRenderParams::new(camera, settings, &scene.shading);
+        let accum_size = accumulation_size(device, &params)?;
+        let scene_buffers = SceneBuffers::upload(device, scene)?;
+        let frame_layout =
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("frame layout"),
+                entries: &[
+                    wgpu::BindGroupLayoutEntry {
+                        binding: 0,
+                        visibility: wgpu::ShaderStages::COMPUTE,
+                        ty: wgpu::BindingType::Buffer {
+                            ty: wgpu::BufferBindingType::Uniform,
+                            has_dynamic_offset: false,
+                            min_binding_size: wgpu::BufferSize::new(
+                                size_of::<GpuRenderParams>() as u64
+                            ),
+                        },
+                        count: None,
+                    },
+                    storage_entry(1, false),
+                    storage_entry(2, false),
+                ],
+            });
+        let stack_size = scene.geometry.stack_bound.next_multiple_of(8);
+        let pipeline = integrator_pipeline(
+            device,
+            &scene_buffers.layout,
+            &frame_layout,
+            accel,
+            stack_size,
+        )?;
+        let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("render params"),
+            size: size_of::<GpuRenderParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let accum_buffer = create_accumulation(device, accum_size);
+        let ray_counter = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ray counter"),
+            size: size_of::<u64>() as u64,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let frame_bind_group = frame_bind_group(
+            device,
+            &frame_layout,
+            &params_buffer,
+            &accum_buffer,
+            &ray_counter,
+        );
+        Ok(Self {
+            ctx: ctx.clone(),
+            scene: scene_buffers,
+            pipeline,
+            params_buffer,
+            accum_buffer,
+            ray_counter,
+            frame_layout,
+            frame_bind_group,
+            rows_ahead: 0,
+            stack_size,
+            rows_per_dispatch: params.height.min(WORKGROUP * 4),
+            batch_samples: 1,
+            adaptive: true,
+            params,
+            samples_done: 0,
+        })
+    }
+
+    /// Fixes the piece size (rows per dispatch, samples per pixel per dispatch) instead of
+    /// sizing pieces from the measured speed. The image does not depend on it: samples are
+    /// seeded per (pixel, index) and summed exactly.
+    pub fn set_piece(&mut self, rows: u32, samples: u32) {
+        self.rows_per_dispatch = rows.clamp(1, self.params.height);
+        self.batch_samples = samples.clamp(1, MAX_BATCH_SAMPLES);
+        self.adaptive = false;
+    }
+
+    /// Rows of the frame in progress that already hold its sample (see
+    /// [`Renderer::step_frame`]).
+    pub fn rows_ahead(&self) -> u32 {
+        self.rows_ahead
+    }
+
+    /// The accumulation buffer (per pixel [`GpuAccumPixel`]: a fixed-point sum of samples),
+    /// for a display pass to read.
+    pub fn accumulation(&self) -> &wgpu::Buffer {
+        &self.accum_buffer
+    }
+
+    /// The device it renders on.
+    pub fn context(&self) -> &GpuContext {
+        &self.ctx
+    }
+
+    fn wait(&self) -> Result<(), RenderError> {
+        self.ctx
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|err| RenderError::Gpu(err.to_string()))
+    }
+
+    /// Queues `samples` samples per pixel for rows `row .. row + rows`.
+    fn submit(&self, row: u32, rows: u32, samples: u32) {
+        let params = GpuRenderParams {
+            sample_offset: self.samples_done,
+            batch_samples: samples,
+            row_offset: row,
+            row_end: row + rows,
+            ..self.params
+        };
+        self.ctx
+            .queue
+            .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("integrator"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &self.scene.bind_group, &[]);
+            pass.set_bind_group(1, &self.frame_bind_group, &[]);
+            pass.dispatch_workgroups(
+                self.params.width.div_ceil(WORKGROUP),
+                rows.div_ceil(WORKGROUP),
+                1,
+            );
+        }
+        self.ctx.queue.submit([encoder.finish()]);
+    }
+
+    /// Sizes the next pieces from the speed of the last `advance`.
+    fn reschedule(&mut self, elapsed: Duration, samples: u32) {
+        let width = u64::from(self.params.width);
+        let height = u64::from(self.params.height);
+        let done = width * height * u64::from(samples);
+        let rate = done as f64 / elapsed.as_secs_f64().max(1e-6);
+        let per_submission = (rate * TARGET_SUBMISSION.as_secs_f64()).max(1.0) as u64;
+        if per_submission >= width * height {
+            self.rows_per_dispatch = self.params.height;
+            self.batch_samples =
+                (per_submission / (width * height)).clamp(1, u64::from(MAX_BATCH_SAMPLES)) as u32;
+        } else {
+            // Whole workgroups of rows, so no invocation idles at a band's edge.
+            let rows =
+                (per_submission / width / u64::from(WORKGROUP)).max(1) * u64::from(WORKGROUP);
+            self.rows_per_dispatch = rows.min(height) as u32;
+            self.batch_samples = 1;
+        }
+    }
+
+    /// Copies a buffer back to the host.
+    fn read_buffer<T: bytemuck::Pod>(&self, buffer: &wgpu::Buffer) -> Result<Vec<T>, RenderError> {
+        let device = &self.ctx.device;
+        let size = buffer.size();
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        self.ctx.queue.submit([encoder.finish()]);
+        let slice = staging.slice(..);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |result| {
+            let _ = sender.send(result);
+        });
+        self.wait()?;
+        receiver
+            .recv()
+            .map_err(|err| RenderError::Gpu(err.to_string()))?
+            .map_err(|err| RenderError::Gpu(err.to_string()))?;
+        let view = slice
+            .get_mapped_range()
+            .map_err(|err| RenderError::Gpu(err.to_string()))?;
+        Ok(bytemuck::cast_slice(&view).to_vec())
+    }
+}
+
+impl Renderer for GpuRenderer {
+    fn device(&self) -> String {
+        describe(&self.ctx.adapter_info)
+    }
+
+    fn size(&self) -> (u32, u32) {
+        (self.params.width, self.params.height)
+    }
+
+    /// Writes only the per-render constants; a new image size also gets a new accumulation
+    /// buffer.
+    fn set_camera(&mut self, camera: &Camera) -> Result<(), RenderError> {
+        let old = (self.params.width, self.params.height);
+        self.params.set_camera(camera);
+        if (camera.width, camera.height) != old {
+            let device = &self.ctx.device;
+            self.accum_buffer =
+                create_accumulation(device, accumulation_size(device, &self.params)?);
+            self.frame_bind_group = frame_bind_group(
+                device,
+                &self.frame_layout,
+                &self.params_buffer,
+                &self.accum_buffer,
+                &self.ray_counter,
+            );
+            self.rows_per_dispatch = camera.height.min(WORKGROUP * 4);
+            self.batch_samples = 1;
+        }
+        self.restart();
+        Ok(())
+    }
+
+    /// Uploads the objects, materials and light table again; the BVH and the pipeline stay.
+    fn set_materials(&mut self, shading: &Shading) -> Result<(), RenderError> {
+        self.scene.set_shading(&self.ctx.device, shading)?;
+        self.params.set_shading(shading);
+        self.restart();
+        Ok(())
+    }
+
+    fn restart(&mut self) {
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        encoder.clear_buffer(&self.accum_buffer, 0, None);
+        encoder.clear_buffer(&self.ray_counter, 0, None);
+        self.ctx.queue.submit([encoder.finish()]);
+        self.samples_done = 0;
+        self.rows_ahead = 0;
+    }
+
+    /// Submits pieces of about [`TARGET_SUBMISSION`] each.
+    fn advance(&mut self, max_samples: u32) -> Result<u32, RenderError> {
+        let samples = self.batch_samples.min(max_samples);
+        if samples == 0 {
+            return Ok(0);
+        }
+        let height = self.params.height;
+        let started = Instant::now();
+        let mut row = 0;
+        while row < height {
+            let rows = self.rows_per_dispatch.min(height - row);
+            self.submit(row, rows, samples);
+            self.wait()?;
+            row += rows;
+        }
+        self.samples_done += samples;
+        if self.adaptive {
+            self.reschedule(started.elapsed(), samples);
+        }
+        Ok(samples)
+    }
+
+    /// Renders the next band of rows, sized so that a submission takes about `target`.
+    /// Rows `0 .. rows_ahead()` of an incomplete frame hold one sample more than the others.
+    fn step_frame(&mut self, target: Duration) -> Result<bool, RenderError> {
+        let height = self.params.height;
+        let rows = self.rows_per_dispatch.min(height - self.rows_ahead);
+        let started = Instant::now();
+        self.submit(self.rows_ahead, rows, 1);
+        self.wait()?;
+        let elapsed = started.elapsed();
+        self.rows_ahead += rows;
+        // Next band: scale by the measured time, in whole workgroups of rows.
+        let scale = target.as_secs_f64() / elapsed.as_secs_f64().max(1e-6);
+        let workgroups = (f64::from(rows) * scale.clamp(0.5, 2.0) / f64::from(WORKGROUP)).round();
+        self.rows_per_dispatch =
+            (workgroups as u32 * WORKGROUP).clamp(WORKGROUP.min(height), height);
+        if self.rows_ahead < height {
+            return Ok(false);
+        }
+        self.rows_ahead = 0;
+        self.samples_done += 1;
+        Ok(true)
+    }
+
+    /// One dispatch over the whole image, not waited for.
+    fn queue_frame(&mut self) -> Result<(), RenderError> {
+        self.submit(0, self.params.height, 1);
+        self.samples_done += 1;
+        Ok(())
+    }
+
+    fn finish(&self) -> Result<(), RenderError> {
+        self.wait()
+    }
+
+    fn samples_done(&self) -> u32 {
+        self.samples_done
+    }
+
+    fn rays_traced(&self) -> Result<u64, RenderError> {
+        let words: Vec<u32> = self.read_buffer(&self.ray_counter)?;
+        Ok(u64::from(words[0]) | (u64::from(words[1]) << 32))
+    }
+
+    /// Copies the accumulation back and divides by each pixel's sample count. `spp` of the
+    /// film counts whole frames only.
+    fn film(&self) -> Result<Film, RenderError> {
+        let accum: Vec<GpuAccumPixel> = self.read_buffer(&self.accum_buffer)?;
+        let width = self.params.width as usize;
+        let pixels = accum
+            .iter()
+            .enumerate()
+            .map(|(i, a)| {
+                // Rows ahead in a frame in progress hold one sample more.
+                let ahead = (i / width) < self.rows_ahead as usize;
+                let scale = 1.0 / f64::from((self.samples_done + u32::from(ahead)).max(1));
+                [0, 1, 2].map(|c| {
+                    let v = (a.channel_sum(c) * scale) as f32;
+                    if v.is_finite() { v } else { 0.0 }
+                })
+            })
+            .collect();
+        Ok(Film {
+            width: self.params.width,
+            height: self.params.height,
+            spp: self.samples_done,
+            pixels,
+        })
+    }
+
+    fn traversal_stack(&self) -> Option<u32> {
+        Some(self.stack_size)
+    }
+}
+
+/// Bytes of the accumulation buffer for `params`' image, or why the device cannot bind it.
+fn accumulation_size(device: &wgpu::Device, params: &GpuRenderParams) -> Result<u64, RenderError> {
+    let pixels = u64::from(params.width) * u64::from(params.height);
+    let size = pixels * size_of::<GpuAccumPixel>() as u64;
+    let limit = device.limits().max_storage_buffer_binding_size;
+    if size > limit {
+        return Err(RenderError::Limits(format!(
+            "a {}x{} image needs a {} MiB accumulation buffer; this device binds at most {} MiB",
+            params.width,
+            params.height,
+            size >> 20,
+            limit >> 20
+        )));
+    }
+    Ok(size)
+}
+
+/// An empty accumulation buffer of `size` bytes.
+fn create_accumulation(device: &wgpu::Device, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("accumulation"),
+        size,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// Bind group 1 of the integrator: parameters, accumulation, ray counter.
+fn frame_bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    params: &wgpu::Buffer,
+    accum: &wgpu::Buffer,
+    ray_counter: &wgpu::Buffer,
+) -> wgpu::BindGroup {
+    bind_buffers(device, "frame", layout, &[params, accum, ray_counter])
+}
+
+/// The integrator pipeline with the given scheme and traversal stack.
+fn integrator_pipeline(
+    device: &wgpu::Device,
+    scene_layout: &wgpu::BindGroupLayout,
+    frame_layout: &wgpu::BindGroupLayout,
+    accel: Accel,
+    stack_size: u32,
+) -> Result<wgpu::ComputePipeline, RenderError> {
+    create_compute_pipeline(
+        device,
+        "integrator",
+        &wgsl::assemble("integrator", &[("STACK_SIZE", stack_size)]).map_err(|err| {
+            RenderError::Pipeline {
+                label: "integrator".into(),
+                message: err.to_string(),
+            }
+        })?,
+        "render",
+        &[scene_layout, frame_layout],
+        &accel.pipeline_constants(),
+    )
+}

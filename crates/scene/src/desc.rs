@@ -1,0 +1,310 @@
+//! The scene file format as plain description data (`docs/scene-format.md`).
+//!
+//! Parsing yields these structs, with the source span of every entity, and nothing
+//! else: building the runtime [`crate::Scene`] from them is [`crate::load`]'s job.
+//! Unknown keys are errors.
+
+use std::collections::BTreeMap;
+
+use serde::Deserialize;
+use toml::Spanned;
+
+/// A whole scene file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDesc {
+    /// How `color` values are to be read: `"srgb"` (default) or `"linear"`.
+    #[serde(default)]
+    pub color_space: ColorSpace,
+    /// The camera.
+    pub camera: Spanned<CameraDesc>,
+    /// Sampling settings; defaults when absent.
+    pub render: Option<Spanned<RenderDesc>>,
+    /// Light arriving from infinitely far away; absent means black.
+    pub environment: Option<Spanned<EnvironmentDesc>>,
+    /// Materials by name.
+    #[serde(default)]
+    pub materials: BTreeMap<String, Spanned<MaterialDesc>>,
+    /// Parallelograms.
+    #[serde(default)]
+    pub quad: Vec<Spanned<QuadDesc>>,
+    /// Analytic spheres.
+    #[serde(default)]
+    pub sphere: Vec<Spanned<SphereDesc>>,
+    /// Cylinders along any axis, optionally capped.
+    #[serde(default)]
+    pub cylinder: Vec<Spanned<CylinderDesc>>,
+    /// Triangle meshes read from OBJ files.
+    #[serde(default)]
+    pub mesh: Vec<Spanned<MeshDesc>>,
+    /// Surfaces of revolution of a profile curve.
+    #[serde(default)]
+    pub revolve: Vec<Spanned<RevolveDesc>>,
+}
+
+/// How `color` triples in the file are encoded.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ColorSpace {
+    /// sRGB-encoded values in [0, 1], decoded to linear for transport (the seed's convention).
+    #[default]
+    Srgb,
+    /// Linear RGB, used verbatim.
+    Linear,
+}
+
+/// A pinhole camera.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    /// Eye position.
+    pub position: [f32; 3],
+    /// Point the camera looks at.
+    pub look_at: [f32; 3],
+    /// Up direction (need not be orthogonal to the view direction).
+    #[serde(default = "default_up")]
+    pub up: [f32; 3],
+    /// Full vertical field of view in degrees.
+    pub fov_y: f32,
+    /// Image size in pixels, `[width, height]`.
+    #[serde(default = "default_resolution")]
+    pub resolution: [u32; 2],
+}
+
+fn default_up() -> [f32; 3] {
+    [0.0, 1.0, 0.0]
+}
+
+fn default_resolution() -> [u32; 2] {
+    [500, 500]
+}
+
+/// Sampling settings.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RenderDesc {
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Maximum path length in segments, as Mitsuba counts it (1 = emitters only, 2 = direct light).
+    pub max_depth: u32,
+    /// Path depth from which Russian roulette may end paths.
+    pub rr_depth: u32,
+    /// Seed of the random sequence.
+    pub seed: u32,
+    /// Sample generator.
+    pub sampler: SamplerDesc,
+}
+
+/// The sample generator.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SamplerDesc {
+    /// Padded Owen-scrambled Sobol (the default).
+    #[default]
+    Sobol,
+    /// Independent hashed random numbers.
+    Independent,
+}
+
+impl Default for RenderDesc {
+    fn default() -> Self {
+        Self {
+            spp: 64,
+            max_depth: 8,
+            rr_depth: 5,
+            seed: 0,
+            sampler: SamplerDesc::Sobol,
+        }
+    }
+}
+
+/// Constant radiance arriving from every direction.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvironmentDesc {
+    /// Linear RGB radiance.
+    pub radiance: [f32; 3],
+}
+
+/// A material: the seed's parameters plus emission and conductors.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDesc {
+    /// Base colour, in the file's `color_space`.
+    #[serde(default = "default_color")]
+    pub color: [f32; 3],
+    /// Image (PNG/JPEG, sRGB) replacing `color`, path relative to the scene file.
+    pub texture: Option<String>,
+    /// Emitted linear radiance (W m^-2 sr^-1), on the front side only.
+    pub emission: Option<[f32; 3]>,
+    /// One of the seed's materials (`metal`, `plastic`, `wall`, `glass`, `wood`, `ceramic`)
+    /// giving defaults for the lobe parameters below.
+    pub preset: Option<String>,
+    /// Weight of the specular reflection lobe.
+    pub specular_rate: Option<f32>,
+    /// Specular colour between white (0) and the base colour (1).
+    pub specular_tint: Option<f32>,
+    /// Roughness of the specular lobe (GGX alpha = roughness^2).
+    pub specular_roughness: Option<f32>,
+    /// Weight of the transmission lobe.
+    pub refract_rate: Option<f32>,
+    /// Transmitted colour between white (0) and the base colour (1).
+    pub refract_tint: Option<f32>,
+    /// Index of refraction of the inside.
+    pub ior: Option<f32>,
+    /// Roughness of transmission (GGX alpha = roughness^2).
+    pub refract_roughness: Option<f32>,
+    /// Conductor Fresnel for the specular lobe: a preset name (`"gold"`, `"aluminium"`, ...).
+    pub conductor: Option<String>,
+    /// Conductor Fresnel from a complex index of refraction: real part per RGB channel.
+    pub eta: Option<[f32; 3]>,
+    /// Conductor Fresnel from a complex index of refraction: imaginary part per RGB channel.
+    pub k: Option<[f32; 3]>,
+}
+
+fn default_color() -> [f32; 3] {
+    [0.8, 0.8, 0.8]
+}
+
+/// The parallelogram `origin + s edge_u + t edge_v`, s, t in [0, 1]; normal `edge_u x edge_v`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuadDesc {
+    /// Optional name, shown when picked.
+    pub name: Option<String>,
+    /// Material name.
+    pub material: String,
+    /// Corner at s = t = 0.
+    pub origin: [f32; 3],
+    /// First edge.
+    pub edge_u: [f32; 3],
+    /// Second edge.
+    pub edge_v: [f32; 3],
+}
+
+/// A sphere.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SphereDesc {
+    /// Optional name, shown when picked.
+    pub name: Option<String>,
+    /// Material name.
+    pub material: String,
+    /// Centre.
+    pub center: [f32; 3],
+    /// Radius.
+    pub radius: f32,
+    /// Rotation of the texture about the vertical (y) axis, degrees.
+    #[serde(default)]
+    pub texture_rotation: f32,
+}
+
+/// A cylinder between two axis end points.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CylinderDesc {
+    /// Optional name, shown when picked.
+    pub name: Option<String>,
+    /// Material name.
+    pub material: String,
+    /// Axis start (bottom).
+    pub p0: [f32; 3],
+    /// Axis end (top).
+    pub p1: [f32; 3],
+    /// Radius.
+    pub radius: f32,
+    /// Closed by two flat disks.
+    #[serde(default = "default_true")]
+    pub caps: bool,
+}
+
+fn default_true() -> bool {
+    true
+}
+
+/// A placement: scale, then rotate (degrees about x, then y, then z), then translate.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransformDesc {
+    /// Scale, uniform or per axis.
+    pub scale: Option<ScaleDesc>,
+    /// Euler angles in degrees, applied x, then y, then z.
+    #[serde(default)]
+    pub rotate: [f32; 3],
+    /// Translation.
+    #[serde(default)]
+    pub translate: [f32; 3],
+}
+
+/// A uniform or per-axis scale.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(untagged)]
+pub enum ScaleDesc {
+    /// The same factor on every axis.
+    Uniform(f32),
+    /// One factor per axis.
+    PerAxis([f32; 3]),
+}
+
+/// A triangle mesh from an OBJ file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshDesc {
+    /// Optional name, shown when picked.
+    pub name: Option<String>,
+    /// Material name.
+    pub material: String,
+    /// OBJ file, relative to the scene file.
+    pub file: String,
+    /// `"smooth"` (interpolated vertex normals, the default) or `"flat"` (geometric normals).
+    #[serde(default)]
+    pub shading: Shading,
+    /// Placement in the world.
+    #[serde(default)]
+    pub transform: TransformDesc,
+}
+
+/// Normals used for shading a mesh.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Shading {
+    /// Vertex normals interpolated across each triangle (from the file, or averaged).
+    #[default]
+    Smooth,
+    /// The geometric normal of each triangle.
+    Flat,
+}
+
+/// A surface of revolution: a profile curve revolved about an axis.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RevolveDesc {
+    /// Optional name, shown when picked.
+    pub name: Option<String>,
+    /// Material name.
+    pub material: String,
+    /// Point on the axis where the profile's height is 0.
+    pub base: [f32; 3],
+    /// Axis direction.
+    #[serde(default = "default_up")]
+    pub axis: [f32; 3],
+    /// Control points `[radius, height]`, bottom to top; a Catmull-Rom spline runs through them.
+    pub profile: Vec<[f32; 2]>,
+    /// Segments around the axis.
+    #[serde(default = "default_segments")]
+    pub segments: u32,
+    /// Rings along the profile.
+    #[serde(default = "default_rings")]
+    pub rings: u32,
+    /// Close the bottom with a disk (a fan of triangles).
+    #[serde(default = "default_true")]
+    pub cap_bottom: bool,
+}
+
+fn default_segments() -> u32 {
+    64
+}
+
+fn default_rings() -> u32 {
+    32
+}

@@ -1,0 +1,45 @@
+//! pathlight's scene: the scene file format and its assets (OBJ meshes, surfaces of
+//! revolution, textures), read into a [`Scene`] in world space and linear RGB. Plain data:
+//! nothing here knows how a backend renders it (that is `pathlight-core`'s job).
+
+pub mod camera;
+pub mod default_scene;
+pub mod desc;
+pub mod error;
+pub mod load;
+pub mod material;
+pub mod mesh;
+pub mod revolve;
+pub mod settings;
+pub mod shape;
+#[cfg(feature = "test-support")]
+pub mod testing;
+pub mod texture;
+
+use glam::Vec3;
+
+pub use camera::Camera;
+pub use error::{RangeError, SceneError};
+pub use load::{SceneSource, load_scene, load_scene_file};
+pub use material::{Conductor, Lobes, Material};
+pub use settings::{RenderSettings, Sampler};
+pub use shape::{Object, Shape, TriangleMesh};
+pub use texture::Texture;
+
+/// A scene ready to be prepared for rendering: resolved, validated, in world space and
+/// linear RGB.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    /// The camera.
+    pub camera: Camera,
+    /// Sampling settings.
+    pub settings: RenderSettings,
+    /// Constant environment radiance (black when there is none).
+    pub environment: Vec3,
+    /// Materials.
+    pub materials: Vec<Material>,
+    /// Textures referenced by materials.
+    pub textures: Vec<Texture>,
+    /// Objects.
+    pub objects: Vec<Object>,
+}

@@ -1,0 +1,220 @@
+//! Scene files: every shipped scene loads, and every kind of bad input gives an error that
+//! names the file and line (or the asset path) and the offending key or value.
+
+use std::path::{Path, PathBuf};
+
+use pathlight_scene::settings::{MAX_RESOLUTION, MAX_SPP};
+use pathlight_scene::{
+    Scene, SceneError, SceneSource, Shape, default_scene, load_scene, load_scene_file,
+};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn data() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data")
+}
+
+const CAMERA: &str =
+    "[camera]\nposition = [0, 0, 3]\nlook_at = [0, 0, 0]\nfov_y = 40\nresolution = [32, 32]\n";
+
+fn load(body: &str) -> Result<Scene, SceneError> {
+    let text = format!("{CAMERA}{body}");
+    load_scene(&SceneSource {
+        name: "test.toml".into(),
+        text: &text,
+        base_dir: data(),
+        embedded: &[],
+    })
+}
+
+fn error(body: &str) -> String {
+    load(body)
+        .expect_err("this scene must be refused")
+        .to_string()
+}
+
+#[test]
+fn shipped_scenes_load() {
+    let mut found = 0;
+    for dir in ["scenes", "scenes/refs"] {
+        for entry in std::fs::read_dir(repo().join(dir)).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "toml") {
+                let scene = load_scene_file(&path).unwrap_or_else(|e| panic!("{e}"));
+                assert!(!scene.objects.is_empty(), "{}", path.display());
+                found += 1;
+            }
+        }
+    }
+    assert_eq!(found, 7, "default + six reference scenes");
+}
+
+#[test]
+fn default_scene_has_the_room_two_lights_and_seven_models() {
+    let scene = default_scene::load().unwrap();
+    let emissive = |o: &&pathlight_scene::Object| {
+        scene.materials[o.material as usize].emission.max_element() > 0.0
+    };
+    let lights: Vec<_> = scene.objects.iter().filter(emissive).collect();
+    assert_eq!(lights.len(), 2);
+    let count = |f: fn(&Shape) -> bool| scene.objects.iter().filter(|o| f(&o.shape)).count();
+    assert_eq!(
+        count(|s| matches!(s, Shape::Quad { .. })),
+        7,
+        "five walls and two lights"
+    );
+    assert_eq!(count(|s| matches!(s, Shape::Sphere { .. })), 3);
+    assert_eq!(count(|s| matches!(s, Shape::Cylinder { .. })), 3);
+    assert_eq!(count(|s| matches!(s, Shape::Mesh(_))), 1, "the vase");
+    assert_eq!(scene.textures.len(), 1);
+    assert_eq!(
+        (scene.textures[0].width, scene.textures[0].height),
+        (2048, 1024)
+    );
+    // The embedded copy is the same scene as the file on disk.
+    let on_disk = load_scene_file(&repo().join("scenes/default.toml")).unwrap();
+    assert_eq!(on_disk, scene);
+}
+
+#[test]
+fn obj_mesh_loads_with_its_transform() {
+    let scene = load(
+        "[materials.m]\n[[mesh]]\nmaterial = \"m\"\nfile = \"tetra.obj\"\ntransform = { scale = 2, translate = [1, 0, 0] }\n",
+    )
+    .unwrap();
+    let Shape::Mesh(mesh) = &scene.objects[0].shape else {
+        panic!("not a mesh")
+    };
+    assert_eq!(mesh.indices.len(), 4);
+    assert!(mesh.positions.contains(&glam::Vec3::new(3.0, 0.0, 0.0)));
+    assert!(mesh.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-5));
+}
+
+#[test]
+fn syntax_errors_name_line_and_key() {
+    let message = error("[materials.m]\ncolr = [1, 0, 0]\n");
+    assert!(message.starts_with("test.toml:7:"), "{message}");
+    assert!(message.contains("colr"), "{message}");
+    let message = error("[[sphere]\n");
+    assert!(message.starts_with("test.toml:6:"), "{message}");
+    let message = error("[[sphere]]\nmaterial = \"m\"\ncenter = [0, 0]\nradius = 1\n");
+    assert!(message.starts_with("test.toml:8:"), "{message}");
+}
+
+#[test]
+fn unknown_material_names_the_shape_line() {
+    let message =
+        error("[materials.m]\n\n[[sphere]]\nmaterial = \"nope\"\ncenter = [0, 0, 0]\nradius = 1\n");
+    assert!(message.starts_with("test.toml:8:"), "{message}");
+    assert!(message.contains("\"nope\""), "{message}");
+}
+
+#[test]
+fn missing_and_broken_assets_name_the_path() {
+    let message = error("[materials.m]\ntexture = \"no-such.png\"\n");
+    assert!(
+        message.contains("no-such.png") && message.starts_with("test.toml:6:"),
+        "{message}"
+    );
+    let message = error("[materials.m]\n[[mesh]]\nmaterial = \"m\"\nfile = \"missing.obj\"\n");
+    assert!(message.contains("missing.obj"), "{message}");
+    let message = error("[materials.m]\n[[mesh]]\nmaterial = \"m\"\nfile = \"broken.obj\"\n");
+    assert!(message.contains("broken.obj"), "{message}");
+    let message = error("[materials.m]\ntexture = \"tetra.obj\"\n");
+    assert!(
+        message.contains("tetra.obj") && message.contains("decode"),
+        "{message}"
+    );
+    let err = load_scene_file(Path::new("/no/such/scene.toml"))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("/no/such/scene.toml"), "{err}");
+}
+
+#[test]
+fn absurd_sizes_are_refused_with_the_limit() {
+    for resolution in ["[0, 32]", "[32, 100000]"] {
+        let text = CAMERA.replace("[32, 32]", resolution);
+        let err = load_scene(&SceneSource {
+            name: "r.toml".into(),
+            text: &text,
+            base_dir: data(),
+            embedded: &[],
+        })
+        .unwrap_err()
+        .to_string();
+        assert!(err.contains(&MAX_RESOLUTION.to_string()), "{err}");
+    }
+    let err = error("[render]\nspp = 0\n");
+    assert!(
+        err.contains(&MAX_SPP.to_string()) && err.starts_with("test.toml:6:"),
+        "{err}"
+    );
+    assert!(error("[render]\nmax_depth = 0\n").contains("max_depth"));
+}
+
+#[test]
+fn out_of_range_material_parameters_are_refused() {
+    let cases = [
+        ("specular_rate = 0.7\nrefract_rate = 0.5", "exceeds 1"),
+        ("ior = 0", "ior"),
+        ("ior = -1.5", "ior"),
+        ("specular_roughness = 1.5", "specular_roughness"),
+        ("refract_roughness = -0.1", "refract_roughness"),
+        ("emission = [1, -1, 0]", "emission"),
+        ("color = [1.2, 0, 0]", "color"),
+        ("conductor = \"unobtainium\"", "gold"),
+        ("eta = [1, 1, 1]", "eta"),
+    ];
+    for (body, needle) in cases {
+        let message = error(&format!("[materials.m]\n{body}\n"));
+        assert!(message.starts_with("test.toml:6:"), "{body}: {message}");
+        assert!(message.contains(needle), "{body}: {message}");
+    }
+}
+
+#[test]
+fn seed_presets_give_defaults_that_keys_override() {
+    let scene = load(
+        "[materials.a]\npreset = \"metal\"\n[materials.b]\npreset = \"glass\"\nior = 1.33\n[materials.c]\npreset = \"ceramic\"\nspecular_rate = 0.5\n",
+    )
+    .unwrap();
+    let m = |name: &str| {
+        scene
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .unwrap()
+            .clone()
+    };
+    assert_eq!(
+        (m("a").lobes.specular_rate, m("a").lobes.specular_tint),
+        (1.0, 1.0)
+    );
+    assert_eq!((m("b").lobes.refract_rate, m("b").lobes.ior), (1.0, 1.33));
+    assert_eq!(m("c").lobes.specular_rate, 0.5);
+    assert!(m("c").lobes.specular_roughness > 0.0);
+    let message = error("[materials.m]\npreset = \"marble\"\n");
+    assert!(
+        message.starts_with("test.toml:6:") && message.contains("ceramic"),
+        "{message}"
+    );
+}
+
+#[test]
+fn colours_are_srgb_unless_the_file_says_linear() {
+    let srgb = load("[materials.m]\ncolor = [0.5, 0.5, 0.5]\n").unwrap();
+    assert!((srgb.materials[0].base_color.x - 0.214_041).abs() < 1e-5);
+    let text =
+        format!("color_space = \"linear\"\n{CAMERA}[materials.m]\ncolor = [0.5, 0.5, 0.5]\n");
+    let linear = load_scene(&SceneSource {
+        name: "l.toml".into(),
+        text: &text,
+        base_dir: data(),
+        embedded: &[],
+    })
+    .unwrap();
+    assert_eq!(linear.materials[0].base_color.x, 0.5);
+}
