@@ -8,7 +8,7 @@ constant environment) to a Mitsuba scene and either
 
   render NAME [--res 512] [--spp 1024]   writes scenes/refs/images/NAME.exr and .png: the
                                          2x2 box average of a res x res render (the
-                                         convention of the team's shared/refs images)
+                                         convention of the images in scenes/refs/images)
   relmse NAME... [--res 128] [--spp 64] [--seeds 8]
                                          prints Mitsuba's own relMSE against the stored
                                          reference: mean over pixels and channels of

@@ -82,7 +82,6 @@ pub struct DeviceArgs {
 #[derive(Debug, clap::Args)]
 pub struct RenderArgs {
     #[command(flatten)]
-    #[allow(missing_docs)]
     pub scene: SceneArgs,
     /// Output image: `.png` (sRGB, clamped, 8-bit) or `.exr` (linear float RGB).
     #[arg(short, long, default_value = "pathlight.png")]
@@ -91,7 +90,6 @@ pub struct RenderArgs {
     #[arg(long)]
     pub spp: Option<u32>,
     #[command(flatten)]
-    #[allow(missing_docs)]
     pub device: DeviceArgs,
     /// List the adapters found and exit.
     #[arg(long)]
@@ -124,10 +122,8 @@ impl From<AccelArg> for pathlight_render::Accel {
 #[derive(Debug, clap::Args)]
 pub struct BenchArgs {
     #[command(flatten)]
-    #[allow(missing_docs)]
     pub scene: SceneArgs,
     #[command(flatten)]
-    #[allow(missing_docs)]
     pub device: DeviceArgs,
     /// Frames to time (one sample per pixel each), after the warm-up.
     #[arg(long, default_value_t = 1000)]
@@ -158,7 +154,6 @@ pub struct BenchArgs {
 #[derive(Debug, clap::Args)]
 pub struct ViewArgs {
     #[command(flatten)]
-    #[allow(missing_docs)]
     pub scene: SceneArgs,
     /// Frames per iteration (one sample per pixel each).
     #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(1..))]
@@ -199,10 +194,15 @@ impl ViewArgs {
     }
 }
 
+/// A command-line value that should be a finite number above zero.
+#[derive(Debug, thiserror::Error)]
+#[error("{0:?} is not a positive finite number")]
+pub struct NotPositive(String);
+
 /// Parses `--light-strength`: a finite number above zero.
-fn positive_strength(text: &str) -> Result<f32, String> {
+fn positive_strength(text: &str) -> Result<f32, NotPositive> {
     match text.parse::<f32>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("{text:?} is not a positive finite number")),
+        _ => Err(NotPositive(text.to_owned())),
     }
 }

@@ -1,4 +1,7 @@
-//! The rendered image: mean linear radiance per pixel.
+//! The rendered image: mean linear radiance per pixel, made from either backend's running
+//! sums, read from and written to OpenEXR, and compared with a reference.
+
+use crate::gpu_types::GpuAccumPixel;
 
 /// Mean linear RGB radiance per pixel, row 0 at the top.
 #[derive(Debug, Clone, PartialEq)]
@@ -14,6 +17,47 @@ pub struct Film {
 }
 
 impl Film {
+    /// The mean of per-pixel sums of `spp` samples each (the CPU backend's, in f64).
+    pub fn from_sums(width: u32, height: u32, spp: u32, sums: &[[f64; 3]]) -> Self {
+        let scale = 1.0 / f64::from(spp.max(1));
+        Self {
+            width,
+            height,
+            spp,
+            pixels: sums.iter().map(|s| s.map(|c| (c * scale) as f32)).collect(),
+        }
+    }
+
+    /// The mean of the GPU's fixed-point sums ([`GpuAccumPixel`]) of `spp` samples per
+    /// pixel, where rows `0 .. rows_ahead` (a frame in progress) hold one sample more. A
+    /// sum too large for f32 reads as 0.
+    pub fn from_fixed_point(
+        width: u32,
+        height: u32,
+        spp: u32,
+        rows_ahead: u32,
+        sums: &[GpuAccumPixel],
+    ) -> Self {
+        let pixels = sums
+            .iter()
+            .enumerate()
+            .map(|(i, a)| {
+                let ahead = (i / width as usize) < rows_ahead as usize;
+                let scale = 1.0 / f64::from((spp + u32::from(ahead)).max(1));
+                [0, 1, 2].map(|c| {
+                    let v = (a.channel_sum(c) * scale) as f32;
+                    if v.is_finite() { v } else { 0.0 }
+                })
+            })
+            .collect();
+        Self {
+            width,
+            height,
+            spp,
+            pixels,
+        }
+    }
+
     /// The pixel at column `x`, row `y`.
     pub fn pixel(&self, x: u32, y: u32) -> [f32; 3] {
         self.pixels[(y * self.width + x) as usize]

@@ -99,7 +99,7 @@ impl RayLanes {
 }
 
 impl CpuScene<'_> {
-    /// Nearest hit on quad, sphere or cylinder object `i`, updating `hit`; Twin of WGSL
+    /// Nearest hit on quad, sphere or cylinder object `i`, updating `hit`. Twin of WGSL
     /// `intersect_shape`.
     #[inline(always)]
     pub fn intersect_shape(&self, i: u32, ray: &Ray, hit: &mut Hit) {
@@ -131,7 +131,7 @@ impl CpuScene<'_> {
         }
     }
 
-    /// Nearest hit on primitive `i` (a shape or a triangle), updating `hit`; Twin of WGSL
+    /// Nearest hit on primitive `i` (a shape or a triangle), updating `hit`. Twin of WGSL
     /// `intersect_primitive`.
     #[inline(always)]
     pub fn intersect_primitive(&self, i: u32, ray: &Ray, hit: &mut Hit) {

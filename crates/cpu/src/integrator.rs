@@ -30,7 +30,7 @@ fn offset_origin(p: Vec3A, ng: Vec3A, dir: Vec3A) -> Vec3A {
 /// The shadow ray testing whether anything blocks the light sample `ls` from surface point
 /// `p` (normal `ng`), and the end of its interval. It runs from the offset origin to the
 /// light point itself, stopping just short of it, so the light never shadows itself. Twin of
-/// WGSL `occluded`.
+/// WGSL `shadow_ray`.
 #[inline(always)]
 fn shadow_ray(p: Vec3A, ng: Vec3A, ls: &LightSample) -> (Ray, f32) {
     let origin = offset_origin(p, ng, ls.wi);
@@ -66,7 +66,7 @@ pub struct ShadowTest {
 }
 
 /// One camera path in progress, between its ray queries: [`Path::ray`] is to be traced and
-/// its nearest hit given to [`Path::step`]. Twin of the state of WGSL `trace_path`'s loop.
+/// its nearest hit given to [`Path::step`]. It holds what the loop of WGSL `trace_path` keeps in its variables.
 #[derive(Debug, Clone)]
 pub struct Path {
     /// The next ray to trace.
@@ -252,7 +252,7 @@ pub fn trace_path(
 }
 
 /// A sample as it is accumulated: non-finite samples count as zero, channels are clamped to
-/// [0, SAMPLE_MAX]. Twin of the checks in WGSL `render` and `add_sample`.
+/// [0, SAMPLE_MAX], as WGSL `render` and `add_sample` accumulate it.
 #[inline(always)]
 pub fn accumulated_value(radiance: Vec3A) -> Vec3A {
     if radiance.is_finite() {

@@ -27,7 +27,7 @@ impl Ray {
     }
 }
 
-/// `1 / d` without infinities; twin of WGSL `safe_inverse`.
+/// `1 / d` without infinities. Twin of WGSL `safe_inverse`.
 #[inline(always)]
 pub fn safe_inverse(d: Vec3) -> Vec3 {
     let tiny = 1e-20_f32;
@@ -41,7 +41,7 @@ pub fn safe_inverse(d: Vec3) -> Vec3 {
     Vec3::ONE / Vec3::new(fix(d.x), fix(d.y), fix(d.z))
 }
 
-/// Parallelogram; twin of WGSL `intersect_quad`. Returns `(t, s, t_param)`.
+/// Parallelogram. Twin of WGSL `intersect_quad`. Returns `(t, s, t_param)`.
 #[inline(always)]
 pub fn intersect_quad(origin: Vec3, eu: Vec3, ev: Vec3, ray: &Ray, t_max: f32) -> (f32, f32, f32) {
     let n = eu.cross(ev);
@@ -63,7 +63,7 @@ pub fn intersect_quad(origin: Vec3, eu: Vec3, ev: Vec3, ray: &Ray, t_max: f32) -
     (t, s, r)
 }
 
-/// Sphere; twin of WGSL `intersect_sphere`.
+/// Sphere. Twin of WGSL `intersect_sphere`.
 #[inline(always)]
 pub fn intersect_sphere(center: Vec3, radius: f32, ray: &Ray, t_max: f32) -> f32 {
     let oc = ray.origin - center;
@@ -85,7 +85,7 @@ pub fn intersect_sphere(center: Vec3, radius: f32, ray: &Ray, t_max: f32) -> f32
     MISS
 }
 
-/// Cylinder; twin of WGSL `intersect_cylinder`.
+/// Cylinder. Twin of WGSL `intersect_cylinder`.
 #[inline(always)]
 pub fn intersect_cylinder(
     p0: Vec3,

@@ -185,16 +185,7 @@ impl Renderer for CpuRenderer {
     }
 
     fn film(&self) -> Result<Film, RenderError> {
-        let scale = 1.0 / f64::from(self.samples_done.max(1));
-        Ok(Film {
-            width: self.params.width,
-            height: self.params.height,
-            spp: self.samples_done,
-            pixels: self
-                .sums
-                .iter()
-                .map(|s| s.map(|c| (c * scale) as f32))
-                .collect(),
-        })
+        let (width, height) = self.size();
+        Ok(Film::from_sums(width, height, self.samples_done, &self.sums))
     }
 }

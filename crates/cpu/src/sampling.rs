@@ -4,7 +4,7 @@ use std::f32::consts::TAU;
 
 use glam::{Vec2, Vec3A};
 
-/// An orthonormal basis. Twin of WGSL `frame_around` (a `mat3x3f` there).
+/// An orthonormal basis (a `mat3x3f` in WGSL, see [`Frame::around`]).
 #[derive(Debug, Clone, Copy)]
 pub struct Frame {
     /// Tangent.

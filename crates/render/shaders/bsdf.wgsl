@@ -13,11 +13,13 @@
 
 const ALPHA_MIN: f32 = 1e-3;
 
+// CPU twin: `BsdfEval`.
 struct BsdfEval {
     f: vec3f,
     pdf: f32,
 }
 
+// CPU twin: `BsdfSample`.
 struct BsdfSample {
     wi: vec3f,
     // f * |cos| / pdf (for a delta lobe: its reflectance or transmittance).
@@ -39,6 +41,7 @@ fn to_local(frame: mat3x3f, v: vec3f) -> vec3f {
 }
 
 // eta = n_transmitted / n_incident, cos_i >= 0.
+// CPU twin: `fresnel_dielectric`.
 fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
     if sin2_t >= 1.0 {
@@ -51,6 +54,7 @@ fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
 }
 
 // Mitsuba 3's `fresnel_conductor`.
+// CPU twin: `fresnel_conductor`.
 fn fresnel_conductor(cos_i: f32, eta: vec3f, k: vec3f) -> vec3f {
     let cos2 = cos_i * cos_i;
     let sin2 = 1.0 - cos2;
@@ -68,6 +72,7 @@ fn fresnel_conductor(cos_i: f32, eta: vec3f, k: vec3f) -> vec3f {
     return 0.5 * (rp + rs);
 }
 
+// CPU twin: `specular_reflectance`.
 fn specular_reflectance(m: Material, color: vec3f, cos_i: f32) -> vec3f {
     if m.conductor != 0u {
         return fresnel_conductor(cos_i, m.eta, m.k);
@@ -76,12 +81,14 @@ fn specular_reflectance(m: Material, color: vec3f, cos_i: f32) -> vec3f {
     return f0 + (1.0 - f0) * pow(1.0 - saturate(cos_i), 5.0);
 }
 
+// CPU twin: `ggx_d`.
 fn ggx_d(m: vec3f, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     let t = (m.x * m.x + m.y * m.y) / a2 + m.z * m.z;
     return 1.0 / (PI * a2 * t * t);
 }
 
+// CPU twin: `ggx_g1`.
 fn ggx_g1(w: vec3f, alpha: f32) -> f32 {
     let z2 = w.z * w.z;
     if z2 <= 0.0 {
@@ -91,6 +98,7 @@ fn ggx_g1(w: vec3f, alpha: f32) -> f32 {
     return 2.0 / (1.0 + sqrt(1.0 + alpha * alpha * tan2));
 }
 
+// CPU twin: `ggx_sample_visible`.
 fn ggx_sample_visible(wo: vec3f, alpha: f32, u: vec2f) -> vec3f {
     let w = select(wo, -wo, wo.z < 0.0);
     let vh = normalize(vec3f(alpha * w.x, alpha * w.y, w.z));
@@ -106,14 +114,17 @@ fn ggx_sample_visible(wo: vec3f, alpha: f32, u: vec2f) -> vec3f {
     return normalize(vec3f(alpha * nh.x, alpha * nh.y, max(nh.z, 1e-7)));
 }
 
+// CPU twin: `ggx_pdf_visible`.
 fn ggx_pdf_visible(wo: vec3f, m: vec3f, alpha: f32) -> f32 {
     return ggx_g1(wo, alpha) * abs(dot(wo, m)) * ggx_d(m, alpha) / abs(wo.z);
 }
 
+// CPU twin: `lobe_weights`.
 fn lobe_weights(m: Material) -> vec3f {
     return vec3f(max(0.0, 1.0 - m.specular_rate - m.refract_rate), m.specular_rate, m.refract_rate);
 }
 
+// CPU twin: `fresnel_dielectric_local`.
 fn fresnel_dielectric_local(cos_om: f32, ior: f32) -> f32 {
     if cos_om >= 0.0 {
         return fresnel_dielectric(cos_om, ior);
@@ -121,6 +132,7 @@ fn fresnel_dielectric_local(cos_om: f32, ior: f32) -> f32 {
     return fresnel_dielectric(-cos_om, 1.0 / ior);
 }
 
+// CPU twin: `eval_rough_dielectric`.
 fn eval_rough_dielectric(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: vec3f, alpha: f32) -> BsdfEval {
     let none = BsdfEval(vec3f(0.0), 0.0);
     let frame = frame_around(s.ns);
@@ -162,6 +174,7 @@ fn eval_rough_dielectric(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: v
     return BsdfEval(tint * ft, pdf_h * abs(dot(wi_l, h)) / denom * (1.0 - fr));
 }
 
+// CPU twin: `eval_bsdf`.
 fn eval_bsdf(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: vec3f) -> BsdfEval {
     let weights = lobe_weights(m);
     let front = dot(wo, s.ng) >= 0.0;
@@ -197,6 +210,7 @@ fn eval_bsdf(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: vec3f) -> Bsd
     return out;
 }
 
+// CPU twin: `mixture_sample`.
 fn mixture_sample(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: vec3f) -> BsdfSample {
     let e = eval_bsdf(m, color, s, wo, wi);
     if !(e.pdf > 0.0 && e.pdf <= 3.0e38) {
@@ -210,6 +224,7 @@ fn mixture_sample(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: vec3f) -
     return BsdfSample(wi, e.f / e.pdf, e.pdf, false, eta, true);
 }
 
+// CPU twin: `sample_smooth_dielectric`.
 fn sample_smooth_dielectric(m: Material, color: vec3f, s: Surface, wo: vec3f, u_fresnel: f32) -> BsdfSample {
     let front = dot(wo, s.ng) >= 0.0;
     let ng = select(-s.ng, s.ng, front);
@@ -231,6 +246,7 @@ fn sample_smooth_dielectric(m: Material, color: vec3f, s: Surface, wo: vec3f, u_
     return BsdfSample(wi, weight, 0.0, true, eta, dot(wi, ng) < 0.0);
 }
 
+// CPU twin: `sample_bsdf`.
 fn sample_bsdf(m: Material, color: vec3f, s: Surface, wo: vec3f, u_lobe: f32, u_fresnel: f32, u: vec2f) -> BsdfSample {
     let weights = lobe_weights(m);
     let front = dot(wo, s.ng) >= 0.0;
@@ -297,6 +313,7 @@ fn sample_bsdf(m: Material, color: vec3f, s: Surface, wo: vec3f, u_lobe: f32, u_
     return mixture_sample(m, color, s, wo, wi);
 }
 
+// CPU twin: `has_continuous_lobe`.
 fn has_continuous_lobe(m: Material) -> bool {
     let w = lobe_weights(m);
     return w.x > 0.0

@@ -31,6 +31,7 @@ const LEAF: u32 = 0x80000000u;
 // No node left to visit.
 const NO_NODE: u32 = 0xffffffffu;
 
+// CPU twin: `Hit`.
 struct Hit {
     t: f32,
     // Index into `objects`, or NO_HIT.
@@ -43,6 +44,7 @@ struct Hit {
 }
 
 // Nearest hit on quad, sphere or cylinder object `i`, updating `hit`.
+// CPU twin: `CpuScene::intersect_shape`.
 fn intersect_shape(i: u32, o: Object, ray: Ray, hit: ptr<function, Hit>) {
     switch o.kind {
         case KIND_QUAD: {
@@ -76,6 +78,7 @@ fn hit_triangle(object: u32, triangle: u32, v0: vec3f, e1: vec3f, e2: vec3f, ray
 }
 
 // Nearest hit on primitive `i`, a shape or a triangle, updating `hit`.
+// CPU twin: `CpuScene::intersect_primitive`.
 fn intersect_primitive(i: u32, ray: Ray, hit: ptr<function, Hit>) {
     let p = primitives[i];
     if p.triangle == NO_TRIANGLE {
@@ -121,8 +124,8 @@ fn intersect_linear(ray: Ray, inv_dir: vec3f, object_count: u32, any_hit: bool, 
 
 // Entry distances (clamped at 0) of the four child boxes of `n`, MISS for those the ray does
 // not enter before t_max. Per axis the near plane is the minimum one unless the ray runs
-// backwards (`backwards`), so an unused child's inverted box is never entered. Twin of
-// `RayLanes::enter`.
+// backwards (`backwards`), so an unused child's inverted box is never entered.
+// CPU twin: `RayLanes::enter`.
 fn enter_children(n: WideNode, origin: vec3f, inv_dir: vec3f, backwards: vec3<bool>, t_max: f32) -> vec4f {
     let near_x = (select(n.lo_x, n.hi_x, backwards.x) - origin.x) * inv_dir.x;
     let far_x = (select(n.hi_x, n.lo_x, backwards.x) - origin.x) * inv_dir.x;
@@ -148,6 +151,7 @@ fn order_pair(ka: ptr<function, f32>, ca: ptr<function, u32>, kb: ptr<function, 
 
 // Nearest hit in (0, t_max) over the whole scene, or with `any_hit` the first one found;
 // `object_count` 0 means an empty scene.
+// CPU twin: `Tracer::trace`.
 fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
     var hit = Hit(t_max, NO_HIT, 0u, 0.0, 0.0);
     if object_count == 0u {

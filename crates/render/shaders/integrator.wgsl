@@ -60,6 +60,7 @@ var<workgroup> workgroup_rays: atomic<u32>;
 const T_MAX: f32 = 1.0e30;
 
 // Start of a ray leaving `p` on the side of `ng` that `dir` points to.
+// CPU twin: `offset_origin`.
 fn offset_origin(p: vec3f, ng: vec3f, dir: vec3f) -> vec3f {
     let eps = 1e-4 * (1.0 + max(max(abs(p.x), abs(p.y)), abs(p.z)));
     return p + select(-ng, ng, dot(dir, ng) > 0.0) * eps;
@@ -72,6 +73,7 @@ struct ShadowRay {
     t_max: f32,
 }
 
+// CPU twin: `shadow_ray`.
 fn shadow_ray(p: vec3f, ng: vec3f, ls: LightSample) -> ShadowRay {
     let origin = offset_origin(p, ng, ls.wi);
     if !ls.finite {
@@ -85,6 +87,7 @@ fn shadow_ray(p: vec3f, ng: vec3f, ls: LightSample) -> ShadowRay {
 // One path. Extension and shadow rays go through a single `trace_scene` call site (a shadow
 // ray is traced before the next extension ray), which keeps the kernel half as large as two
 // inlined traversals; the estimator and the order of every sum are those of the CPU twin.
+// CPU twin: `trace_path`.
 fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
     var ray = first;
     var radiance = vec3f(0.0);

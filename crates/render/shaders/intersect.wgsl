@@ -25,6 +25,7 @@ fn intersect_aabb(b: Aabb, origin: vec3f, inv_dir: vec3f, t_max: f32) -> f32 {
 }
 
 // 1 / d with zero components replaced by a tiny value of the same sign.
+// CPU twin: `safe_inverse`.
 fn safe_inverse(d: vec3f) -> vec3f {
     let tiny = 1e-20;
     let x = select(d.x, select(-tiny, tiny, d.x >= 0.0), abs(d.x) < tiny);
@@ -34,6 +35,7 @@ fn safe_inverse(d: vec3f) -> vec3f {
 }
 
 // Parallelogram origin + s eu + t ev; returns (t, s, t_param).
+// CPU twin: `intersect_quad`.
 fn intersect_quad(origin: vec3f, eu: vec3f, ev: vec3f, ray: Ray, t_max: f32) -> vec3f {
     let n = cross(eu, ev);
     let denom = dot(n, ray.dir);
@@ -56,6 +58,7 @@ fn intersect_quad(origin: vec3f, eu: vec3f, ev: vec3f, ray: Ray, t_max: f32) -> 
 
 // Sphere; `ray.dir` is unit. The discriminant uses the closest-approach form
 // (Haines et al., Ray Tracing Gems ch. 7) to stay accurate far from the sphere.
+// CPU twin: `intersect_sphere`.
 fn intersect_sphere(center: vec3f, radius: f32, ray: Ray, t_max: f32) -> f32 {
     let oc = ray.origin - center;
     let b = -dot(oc, ray.dir);
@@ -77,6 +80,7 @@ fn intersect_sphere(center: vec3f, radius: f32, ray: Ray, t_max: f32) -> f32 {
 }
 
 // Cylinder from p0 to p1 (side, and the end disks when `caps`).
+// CPU twin: `intersect_cylinder`.
 fn intersect_cylinder(p0: vec3f, p1: vec3f, radius: f32, caps: bool, ray: Ray, t_max: f32) -> f32 {
     let axis_full = p1 - p0;
     let height = length(axis_full);
@@ -120,6 +124,7 @@ fn intersect_cylinder(p0: vec3f, p1: vec3f, radius: f32, caps: bool, ray: Ray, t
 
 // Moller-Trumbore on corner v0 and edges e1 = v1 - v0, e2 = v2 - v0; returns (t, b1, b2)
 // with barycentrics of vertices 1 and 2.
+// CPU twin: `intersect_triangle_edges`.
 fn intersect_triangle_edges(v0: vec3f, e1: vec3f, e2: vec3f, ray: Ray, t_max: f32) -> vec3f {
     let p = cross(ray.dir, e2);
     let det = dot(e1, p);

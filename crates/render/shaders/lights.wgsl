@@ -9,6 +9,7 @@
 #import intersect
 #import sampling
 
+// CPU twin: `LightSample`.
 struct LightSample {
     wi: vec3f,
     // The point on the light (unused for the environment).
@@ -26,6 +27,7 @@ fn invalid_light_sample() -> LightSample {
 }
 
 // n: the normal on the side light is gathered from.
+// CPU twin: `env_pdf`.
 fn env_pdf(n: vec3f, wi: vec3f) -> f32 {
     return params.env_pmf * max(0.0, dot(n, wi)) / PI;
 }
@@ -33,6 +35,7 @@ fn env_pdf(n: vec3f, wi: vec3f) -> f32 {
 // Surface area of light-table entry (o, primitive): the whole shape, or one triangle of a
 // mesh. The host computes the same areas to weigh the light table by power
 // (`crates/core/src/light_table.rs`).
+// CPU twin: `emitter_area`.
 fn emitter_area(o: Object, primitive: u32) -> f32 {
     switch o.kind {
         case KIND_QUAD: {
@@ -55,6 +58,7 @@ fn emitter_area(o: Object, primitive: u32) -> f32 {
 }
 
 // 1 - cos of the half-angle of the cone a sphere subtends from p; negative inside it.
+// CPU twin: `sphere_cone`.
 fn sphere_cone(center: vec3f, radius: f32, p: vec3f) -> f32 {
     let d = center - p;
     let d2 = dot(d, d);
@@ -67,6 +71,7 @@ fn sphere_cone(center: vec3f, radius: f32, p: vec3f) -> f32 {
     return sin2_max / (1.0 + cos_max);
 }
 
+// CPU twin: `light_pdf`.
 fn light_pdf(object: u32, primitive: u32, p: vec3f, p_light: vec3f, n_light: vec3f) -> f32 {
     let o = objects[object];
     var entry = o.light;
@@ -98,6 +103,7 @@ struct ShapeSample {
     density: f32,
 }
 
+// CPU twin: `sample_shape`.
 fn sample_shape(o: Object, primitive: u32, p: vec3f, u: vec2f, u_part: f32) -> ShapeSample {
     let a = o.a.xyz;
     let b = o.b.xyz;
@@ -157,6 +163,7 @@ fn sample_shape(o: Object, primitive: u32, p: vec3f, u: vec2f, u_part: f32) -> S
     }
 }
 
+// CPU twin: `sample_light`.
 fn sample_light(p: vec3f, n: vec3f, u_select: f32, u: vec2f) -> LightSample {
     if u_select < params.env_pmf {
         let wi = frame_around(n) * sample_cosine_hemisphere(u);

@@ -9,17 +9,20 @@
 const SAMPLER_SOBOL: u32 = 0u;
 
 // PCG hash: Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 2020.
+// CPU twin: `pcg_hash`.
 fn pcg_hash(v: u32) -> u32 {
     let state = v * 747796405u + 2891336453u;
     let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
     return (word >> 22u) ^ word;
 }
 
+// CPU twin: `rng_init`.
 fn rng_init(pixel: u32, sample_index: u32, seed: u32) -> u32 {
     return pcg_hash(pixel ^ pcg_hash(sample_index ^ pcg_hash(seed)));
 }
 
 // Owen scrambling of bits from low to high (Laine and Karras 2011, Burley's constants).
+// CPU twin: `laine_karras`.
 fn laine_karras(v: u32, seed: u32) -> u32 {
     var x = v + seed;
     x ^= x * 0x6c50b47cu;
@@ -34,6 +37,7 @@ fn laine_karras(v: u32, seed: u32) -> u32 {
 // (counted from the top) is the XOR of the index bits k that are supersets of p: a
 // superset-XOR transform in five bit-parallel steps. (Dimension 0, van der Corput, is the
 // index reversed.)
+// CPU twin: `sobol_1_reversed`.
 fn sobol_1_reversed(index: u32) -> u32 {
     var y = index;
     y ^= (y >> 1u) & 0x55555555u;
@@ -46,14 +50,17 @@ fn sobol_1_reversed(index: u32) -> u32 {
 
 // Owen scrambling (high bits to low) of a Sobol value given bit-reversed:
 // reverseBits(laine_karras(reverseBits(v))) without reversing v twice.
+// CPU twin: `owen_scramble_reversed`.
 fn owen_scramble_reversed(reversed: u32, seed: u32) -> u32 {
     return reverseBits(laine_karras(reversed, seed));
 }
 
+// CPU twin: `to_unit_float`.
 fn to_unit_float(x: u32) -> f32 {
     return f32(x >> 8u) * (1.0 / 16777216.0);
 }
 
+// CPU twin: `Sampler`.
 struct Sampler {
     kind: u32,
     pixel_seed: u32,
@@ -62,6 +69,7 @@ struct Sampler {
     rng_state: u32,
 }
 
+// CPU twin: `Sampler::new`.
 fn sampler_init(kind: u32, pixel: u32, index: u32, seed: u32) -> Sampler {
     return Sampler(kind, pcg_hash(pixel ^ pcg_hash(seed)), reverseBits(index), 0u, rng_init(pixel, index, seed));
 }
@@ -84,6 +92,7 @@ fn shuffled_index(s: ptr<function, Sampler>, seed: u32) -> u32 {
     return owen_scramble_reversed((*s).index_reversed, seed);
 }
 
+// CPU twin: `Sampler::next_1d`.
 fn next_1d(s: ptr<function, Sampler>) -> f32 {
     if (*s).kind != SAMPLER_SOBOL {
         return next_random(s);
@@ -93,6 +102,7 @@ fn next_1d(s: ptr<function, Sampler>) -> f32 {
     return to_unit_float(owen_scramble_reversed(index, pcg_hash(seed ^ 1u)));
 }
 
+// CPU twin: `Sampler::next_2d`.
 fn next_2d(s: ptr<function, Sampler>) -> vec2f {
     if (*s).kind != SAMPLER_SOBOL {
         let x = next_random(s);

@@ -5,6 +5,7 @@ const TAU: f32 = 6.28318530717959;
 
 // Orthonormal basis around unit `n` (Duff et al., "Building an Orthonormal Basis,
 // Revisited", JCGT 2017). Columns: tangent, bitangent, n.
+// CPU twin: `Frame::around`.
 fn frame_around(n: vec3f) -> mat3x3f {
     let s = select(-1.0, 1.0, n.z >= 0.0);
     let a = -1.0 / (s + n.z);
@@ -15,6 +16,7 @@ fn frame_around(n: vec3f) -> mat3x3f {
 }
 
 // Cosine-weighted direction about +z; pdf = cos(theta) / pi.
+// CPU twin: `sample_cosine_hemisphere`.
 fn sample_cosine_hemisphere(u: vec2f) -> vec3f {
     let r = sqrt(u.x);
     let phi = TAU * u.y;
@@ -22,6 +24,7 @@ fn sample_cosine_hemisphere(u: vec2f) -> vec3f {
 }
 
 // Uniform direction on the unit sphere; pdf = 1 / (4 pi).
+// CPU twin: `sample_uniform_sphere`.
 fn sample_uniform_sphere(u: vec2f) -> vec3f {
     let z = 1.0 - 2.0 * u.x;
     let r = sqrt(max(0.0, 1.0 - z * z));
@@ -30,6 +33,7 @@ fn sample_uniform_sphere(u: vec2f) -> vec3f {
 }
 
 // Uniform point on the unit disk (polar).
+// CPU twin: `sample_disk`.
 fn sample_disk(u: vec2f) -> vec2f {
     let r = sqrt(u.x);
     let phi = TAU * u.y;
@@ -37,6 +41,7 @@ fn sample_disk(u: vec2f) -> vec2f {
 }
 
 // Power heuristic (beta = 2) weight of a strategy with density `a` against one with `b`.
+// CPU twin: `power_heuristic`.
 fn power_heuristic(a: f32, b: f32) -> f32 {
     let a2 = a * a;
     let b2 = b * b;

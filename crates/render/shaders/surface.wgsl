@@ -6,6 +6,7 @@
 #import bvh
 #import sampling
 
+// CPU twin: `Surface`.
 struct Surface {
     position: vec3f,
     // Geometric normal on the shape's front side (quad: edge_u x edge_v; solids: outward).
@@ -16,18 +17,21 @@ struct Surface {
     material: u32,
 }
 
+// CPU twin: `srgb_to_linear`.
 fn srgb_to_linear(c: vec3f) -> vec3f {
     let low = c / 12.92;
     let high = pow((c + 0.055) / 1.055, vec3f(2.4));
     return select(high, low, c <= vec3f(0.04045));
 }
 
+// CPU twin: `texel`.
 fn texel(info: TextureInfo, x: u32, y: u32) -> vec3f {
     let packed = texels[info.offset + y * info.width + x];
     return srgb_to_linear(unpack4x8unorm(packed).rgb);
 }
 
 // Bilinear lookup in linear RGB: u wraps, v clamps; v = 0 is the top row.
+// CPU twin: `sample_texture`.
 fn sample_texture(index: u32, uv: vec2f) -> vec3f {
     let info = textures[index];
     let size = vec2f(f32(info.width), f32(info.height));
@@ -43,6 +47,7 @@ fn sample_texture(index: u32, uv: vec2f) -> vec3f {
     return mix(top, bottom, f.y);
 }
 
+// CPU twin: `base_color`.
 fn base_color(material: Material, uv: vec2f) -> vec3f {
     if material.texture >= 0 {
         return sample_texture(u32(material.texture), uv);
@@ -50,6 +55,7 @@ fn base_color(material: Material, uv: vec2f) -> vec3f {
     return material.base_color;
 }
 
+// CPU twin: `surface_at`.
 fn surface_at(hit: Hit, ray: Ray) -> Surface {
     let o = objects[hit.object];
     let p = ray.origin + hit.t * ray.dir;

@@ -402,26 +402,14 @@ impl Renderer for GpuRenderer {
     /// film counts whole frames only.
     fn film(&self) -> Result<Film, RenderError> {
         let accum: Vec<GpuAccumPixel> = self.read_buffer(&self.accum_buffer)?;
-        let width = self.params.width as usize;
-        let pixels = accum
-            .iter()
-            .enumerate()
-            .map(|(i, a)| {
-                // Rows ahead in a frame in progress hold one sample more.
-                let ahead = (i / width) < self.rows_ahead as usize;
-                let scale = 1.0 / f64::from((self.samples_done + u32::from(ahead)).max(1));
-                [0, 1, 2].map(|c| {
-                    let v = (a.channel_sum(c) * scale) as f32;
-                    if v.is_finite() { v } else { 0.0 }
-                })
-            })
-            .collect();
-        Ok(Film {
-            width: self.params.width,
-            height: self.params.height,
-            spp: self.samples_done,
-            pixels,
-        })
+        let (width, height) = self.size();
+        Ok(Film::from_fixed_point(
+            width,
+            height,
+            self.samples_done,
+            self.rows_ahead,
+            &accum,
+        ))
     }
 
     fn traversal_stack(&self) -> Option<u32> {
