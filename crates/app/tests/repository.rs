@@ -30,8 +30,19 @@ fn text_files(dir: &Path, out: &mut Vec<PathBuf>) {
 
 /// Folders a cited path may start with: the repository's own, or a crate's.
 const ROOTS: [&str; 13] = [
-    "crates/", "scenes/", "docs/", "bench/", "tools/", "assets/", "examples/", ".ci/", "src/",
-    "shaders/", "tests/", "view/", "images/",
+    "crates/",
+    "scenes/",
+    "docs/",
+    "bench/",
+    "tools/",
+    "assets/",
+    "examples/",
+    ".ci/",
+    "src/",
+    "shaders/",
+    "tests/",
+    "view/",
+    "images/",
 ];
 
 /// The paths `text` cites: backticked tokens that start with one of [`ROOTS`] (or `./`,
@@ -54,7 +65,8 @@ fn cited_paths(text: &str) -> Vec<String> {
         let rest = &text[i + 2..];
         if let Some(end) = rest.find(')') {
             let target = &rest[..end];
-            let url_or_item = target.contains("://") || target.contains("::") || target.starts_with('#');
+            let url_or_item =
+                target.contains("://") || target.contains("::") || target.starts_with('#');
             if !url_or_item && target.contains(['/', '.']) {
                 cited.push(target.split('#').next().unwrap_or(target).to_owned());
             }
@@ -74,7 +86,9 @@ fn cited_paths(text: &str) -> Vec<String> {
 /// The crate folder holding `file`, if any.
 fn crate_of(file: &Path) -> Option<PathBuf> {
     file.ancestors()
-        .find(|dir| dir.join("Cargo.toml").is_file() && dir.parent().is_some_and(|p| p.ends_with("crates")))
+        .find(|dir| {
+            dir.join("Cargo.toml").is_file() && dir.parent().is_some_and(|p| p.ends_with("crates"))
+        })
         .map(Path::to_owned)
 }
 
@@ -98,13 +112,21 @@ fn every_cited_path_exists() {
                 .any(|base| base.join(path.trim_end_matches('/')).exists());
             checked += 1;
             if !exists {
-                let shown = file.strip_prefix(&root).unwrap_or(file).display().to_string();
+                let shown = file
+                    .strip_prefix(&root)
+                    .unwrap_or(file)
+                    .display()
+                    .to_string();
                 missing.push(format!("{shown}: `{path}`"));
             }
         }
     }
     assert!(checked > 50, "only {checked} cited paths found");
-    assert!(missing.is_empty(), "cited paths that do not exist:\n{}", missing.join("\n"));
+    assert!(
+        missing.is_empty(),
+        "cited paths that do not exist:\n{}",
+        missing.join("\n")
+    );
 }
 
 #[test]
@@ -121,12 +143,20 @@ fn no_file_cites_documents_outside_the_repository() {
                 .iter()
                 .any(|outside| line.contains(outside))
             {
-                let shown = file.strip_prefix(&root).unwrap_or(file).display().to_string();
+                let shown = file
+                    .strip_prefix(&root)
+                    .unwrap_or(file)
+                    .display()
+                    .to_string();
                 found.push(format!("{shown}:{}: {line}", n + 1));
             }
         }
     }
-    assert!(found.is_empty(), "citations of documents the repository does not hold:\n{}", found.join("\n"));
+    assert!(
+        found.is_empty(),
+        "citations of documents the repository does not hold:\n{}",
+        found.join("\n")
+    );
 }
 
 #[test]

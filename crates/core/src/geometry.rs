@@ -304,7 +304,9 @@ fn triangle_bounds(mesh: &TriangleMesh, t: usize) -> Aabb {
 #[cfg(test)]
 mod tests {
     use glam::Vec3;
-    use pathlight_scene::testing::{mesh_of, object, random_mesh, random_objects, scene_of};
+    use pathlight_scene::testing::{
+        coincident_triangles, degenerate_objects, object, random_mesh, random_objects, scene_of,
+    };
     use pathlight_scene::{Object, Shape};
     use rand::SeedableRng;
     use rand::rngs::StdRng;
@@ -446,30 +448,8 @@ mod tests {
 
     #[test]
     fn degenerate_and_coincident_triangles_build_valid_trees() {
-        let degenerate = mesh_of(&[
-            [Vec3::ZERO, Vec3::X, Vec3::X * 2.0],
-            [Vec3::Y, Vec3::Y, Vec3::Z],
-            [
-                Vec3::new(-1.0, -1.0, 0.0),
-                Vec3::new(1.0, -1.0, 0.0),
-                Vec3::Y,
-            ],
-        ]);
-        let flat = Shape::Quad {
-            origin: Vec3::new(-1.0, -1.0, -2.0),
-            edge_u: Vec3::X * 2.0,
-            edge_v: Vec3::Y * 2.0,
-        };
-        validate(&Geometry::build(&[
-            object("mesh", Shape::Mesh(degenerate)),
-            object("flat quad", flat),
-        ]));
-        // 5,000 copies of one triangle: no centroid splits them, whatever depth the build makes.
-        let copies = vec![[Vec3::new(-1.0, -1.0, 0.0), Vec3::X, Vec3::Y]; 5000];
-        validate(&Geometry::build(&[object(
-            "stack",
-            Shape::Mesh(mesh_of(&copies)),
-        )]));
+        validate(&Geometry::build(&degenerate_objects()));
+        validate(&Geometry::build(&coincident_triangles(5000)));
     }
 
     #[test]

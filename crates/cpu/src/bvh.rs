@@ -287,7 +287,8 @@ pub(crate) mod tests {
     use pathlight_core::bvh::lane_used;
     use pathlight_core::gpu_types::KIND_MESH;
     use pathlight_scene::testing::{
-        mesh_of, object, random_mesh, random_objects, random_point, scene_of,
+        coincident_triangles, degenerate_objects, object, random_mesh, random_objects,
+        random_point, scene_of,
     };
     use pathlight_scene::{Object, Shape};
     use rand::rngs::StdRng;
@@ -445,24 +446,7 @@ pub(crate) mod tests {
 
     #[test]
     fn degenerate_triangles_coincident_triangles_and_axis_rays() {
-        let degenerate = mesh_of(&[
-            [Vec3::ZERO, Vec3::X, Vec3::X * 2.0],
-            [Vec3::Y, Vec3::Y, Vec3::Z],
-            [
-                Vec3::new(-1.0, -1.0, 0.0),
-                Vec3::new(1.0, -1.0, 0.0),
-                Vec3::Y,
-            ],
-        ]);
-        let flat = Shape::Quad {
-            origin: Vec3::new(-1.0, -1.0, -2.0),
-            edge_u: Vec3::X * 2.0,
-            edge_v: Vec3::Y * 2.0,
-        };
-        let prepared = prepare(vec![
-            object("mesh", Shape::Mesh(degenerate)),
-            object("flat", flat),
-        ]);
+        let prepared = prepare(degenerate_objects());
         let scene = CpuScene::new(&prepared);
         // Rays along the axes (zero direction components) through the flat boxes.
         let mut rays = vec![
@@ -484,9 +468,7 @@ pub(crate) mod tests {
             None,
             "t_max bounds the search"
         );
-        // 5,000 copies of one triangle.
-        let copies = vec![[Vec3::new(-1.0, -1.0, 0.0), Vec3::X, Vec3::Y]; 5000];
-        let prepared = prepare(vec![object("stack", Shape::Mesh(mesh_of(&copies)))]);
+        let prepared = prepare(coincident_triangles(5000));
         let scene = CpuScene::new(&prepared);
         let rays: Vec<Ray> = (0..200).map(|_| random_ray(&mut rng, 0.5)).collect();
         assert!(assert_walk(&scene, &rays) > 20);

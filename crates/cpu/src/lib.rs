@@ -186,6 +186,11 @@ impl Renderer for CpuRenderer {
 
     fn film(&self) -> Result<Film, RenderError> {
         let (width, height) = self.size();
-        Ok(Film::from_sums(width, height, self.samples_done, &self.sums))
+        Ok(Film::from_sums(
+            width,
+            height,
+            self.samples_done,
+            &self.sums,
+        ))
     }
 }

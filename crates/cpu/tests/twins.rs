@@ -176,23 +176,44 @@ fn every_integrator_file_has_its_twin_file() {
         "lights",
         "integrator",
     ] {
-        assert!(shaders().join(format!("{stem}.wgsl")).is_file(), "{stem}.wgsl");
-        assert!(cpu_src().join(format!("{stem}.rs")).is_file(), "src/{stem}.rs");
+        assert!(
+            shaders().join(format!("{stem}.wgsl")).is_file(),
+            "{stem}.wgsl"
+        );
+        assert!(
+            cpu_src().join(format!("{stem}.rs")).is_file(),
+            "src/{stem}.rs"
+        );
     }
 }
 
 #[test]
 fn the_parsers_read_the_convention() {
     assert_eq!(
-        quoted_after("x. Twin of WGSL `a_b` and Twin of WGSL\n `c`.", "Twin of WGSL"),
+        quoted_after(
+            "x. Twin of WGSL `a_b` and Twin of WGSL\n `c`.",
+            "Twin of WGSL"
+        ),
         ["a_b", "c"]
     );
-    assert_eq!(rust_item("pub(crate) fn enter(&self)").as_deref(), Some("enter"));
-    assert_eq!(rust_item("pub const fn pcg_hash(v: u32)").as_deref(), Some("pcg_hash"));
+    assert_eq!(
+        rust_item("pub(crate) fn enter(&self)").as_deref(),
+        Some("enter")
+    );
+    assert_eq!(
+        rust_item("pub const fn pcg_hash(v: u32)").as_deref(),
+        Some("pcg_hash")
+    );
     assert_eq!(rust_item("struct Hit {").as_deref(), Some("Hit"));
     assert_eq!(rust_item("let x = 1;"), None);
-    assert_eq!(impl_type("impl<'a> Tracer<'a> {").as_deref(), Some("Tracer"));
-    assert_eq!(impl_type("impl Renderer for CpuRenderer {").as_deref(), Some("CpuRenderer"));
+    assert_eq!(
+        impl_type("impl<'a> Tracer<'a> {").as_deref(),
+        Some("Tracer")
+    );
+    assert_eq!(
+        impl_type("impl Renderer for CpuRenderer {").as_deref(),
+        Some("CpuRenderer")
+    );
     let items = wgsl_items("// A.\n// CPU twin: `x`.\nfn f(a: u32) {}\n\n// B.\nstruct S {}\n");
     assert_eq!(items[0], ("f".into(), " A. CPU twin: `x`.".into()));
     assert_eq!(items[1].0, "S");

@@ -124,3 +124,34 @@ pub fn object(name: &str, shape: Shape) -> Object {
         shape,
     }
 }
+
+/// A mesh of degenerate triangles (zero area: collinear corners, a repeated corner) and one
+/// proper triangle in the plane z = 0 (corners (-1, -1), (1, -1), (0, 1)), and a flat quad
+/// covering [-1, 1]^2 at z = -2: boxes of no thickness, hit by rays along the axes.
+pub fn degenerate_objects() -> Vec<Object> {
+    let mesh = mesh_of(&[
+        [Vec3::ZERO, Vec3::X, Vec3::X * 2.0],
+        [Vec3::Y, Vec3::Y, Vec3::Z],
+        [
+            Vec3::new(-1.0, -1.0, 0.0),
+            Vec3::new(1.0, -1.0, 0.0),
+            Vec3::Y,
+        ],
+    ]);
+    let flat = Shape::Quad {
+        origin: Vec3::new(-1.0, -1.0, -2.0),
+        edge_u: Vec3::X * 2.0,
+        edge_v: Vec3::Y * 2.0,
+    };
+    vec![object("mesh", Shape::Mesh(mesh)), object("flat quad", flat)]
+}
+
+/// `copies` copies of one triangle (corners (-1, -1, 0), (1, 0, 0), (0, 1, 0)): no centroid
+/// split separates them, whatever depth a build makes.
+pub fn coincident_triangles(copies: usize) -> Vec<Object> {
+    let triangle = [Vec3::new(-1.0, -1.0, 0.0), Vec3::X, Vec3::Y];
+    vec![object(
+        "stack",
+        Shape::Mesh(mesh_of(&vec![triangle; copies])),
+    )]
+}
