@@ -361,7 +361,8 @@ pub fn sample_bsdf(
         let h = ggx_sample_visible(wo_l, alpha, u);
         let cos_oh = wo_l.dot(h);
         let fr = fresnel_dielectric_local(cos_oh, m.ior);
-        let wi_l = if u_fresnel < fr {
+        let reflect = u_fresnel < fr;
+        let wi_l = if reflect {
             2.0 * cos_oh * h - wo_l
         } else {
             // Refract wo through h: relative IOR seen from wo's side.
@@ -376,6 +377,12 @@ pub fn sample_bsdf(
             }
             -wo_l / eta + (c / eta - (1.0 - sin2_t).sqrt()) * hf
         };
+        // Through a microfacet, a reflection can point below the surface and a refraction
+        // above it: such a direction belongs to the other lobe, whose density does not
+        // count this way of reaching it, so it is discarded (as pbrt-v4 and Mitsuba do).
+        if (wi_l.z * wo_l.z > 0.0) != reflect {
+            return INVALID;
+        }
         return mixture_sample(m, color, s, wo, frame.to_world(wi_l));
     }
     if cos_o <= 0.0 {

@@ -288,7 +288,8 @@ fn sample_bsdf(m: Material, color: vec3f, s: Surface, wo: vec3f, u_lobe: f32, u_
         let cos_oh = dot(wo_l, h);
         let fr = fresnel_dielectric_local(cos_oh, m.ior);
         var wi_l: vec3f;
-        if u_fresnel < fr {
+        let reflect = u_fresnel < fr;
+        if reflect {
             wi_l = 2.0 * cos_oh * h - wo_l;
         } else {
             let outside = cos_oh >= 0.0;
@@ -300,6 +301,11 @@ fn sample_bsdf(m: Material, color: vec3f, s: Surface, wo: vec3f, u_lobe: f32, u_
                 return invalid_sample();
             }
             wi_l = -wo_l / eta + (c / eta - sqrt(1.0 - sin2_t)) * hf;
+        }
+        // A reflection below the surface or a refraction above it belongs to the other
+        // lobe, whose density does not count this way of reaching it: discarded.
+        if (wi_l.z * wo_l.z > 0.0) != reflect {
+            return invalid_sample();
         }
         return mixture_sample(m, color, s, wo, frame * wi_l);
     }
