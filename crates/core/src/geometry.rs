@@ -194,8 +194,8 @@ impl Geometry {
                     let corners = mesh.indices[p.triangle as usize];
                     let [v0, v1, v2] = corners.map(|v| mesh.positions[v as usize]);
                     primitive.v0 = v0.to_array();
-                    primitive.e1 = (v1 - v0).to_array();
-                    primitive.e2 = (v2 - v0).to_array();
+                    primitive.v1 = v1.to_array();
+                    primitive.v2 = v2.to_array();
                 }
                 primitive
             })
@@ -374,9 +374,9 @@ mod tests {
                         );
                         let [v0, v1, v2] = g.triangle(tri);
                         assert_eq!(
-                            [prim.v0, prim.e1, prim.e2],
-                            [v0, v1 - v0, v2 - v0].map(|v| v.to_array()),
-                            "primitive {p}: not triangle {tri}'s corner and edges"
+                            [prim.v0, prim.v1, prim.v2],
+                            [v0, v1, v2].map(|v| v.to_array()),
+                            "primitive {p}: not triangle {tri}'s corners"
                         );
                         for v in [v0, v1, v2] {
                             assert!(contains(&n, lane, v, v), "triangle {tri} escapes its leaf");

@@ -128,8 +128,9 @@ const _: () = assert!(size_of::<GpuVertex>() == 32);
 /// [`GpuPrimitive::triangle`] of a quad, sphere or cylinder.
 pub const NO_TRIANGLE: u32 = u32::MAX;
 
-/// One primitive of the BVH, in leaf order: a triangle in the form the intersection test
-/// wants (its first corner and the two edges from it) or a whole analytic shape. WGSL:
+/// One primitive of the BVH, in leaf order: a triangle with its three corners (the
+/// watertight test needs the corners themselves: corners rebuilt from edges would round
+/// differently in the triangles that share them) or a whole analytic shape. WGSL:
 /// `Primitive`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
@@ -138,12 +139,12 @@ pub struct GpuPrimitive {
     pub v0: [f32; 3],
     /// The object it belongs to (index into the object buffer).
     pub object: u32,
-    /// Triangle: corner 1 minus corner 0.
-    pub e1: [f32; 3],
+    /// Triangle: corner 1.
+    pub v1: [f32; 3],
     /// The triangle's index in the vertex buffer, or [`NO_TRIANGLE`] for a shape.
     pub triangle: u32,
-    /// Triangle: corner 2 minus corner 0.
-    pub e2: [f32; 3],
+    /// Triangle: corner 2.
+    pub v2: [f32; 3],
     /// Padding.
     pub pad: u32,
 }

@@ -11,8 +11,8 @@ use pathlight_core::gpu_types::{
 
 use crate::cpu_scene::CpuScene;
 use crate::intersect::{
-    Ray, intersect_cylinder, intersect_quad, intersect_sphere, intersect_triangle_edges,
-    safe_inverse,
+    ROBUST_FAR, Ray, ShearedRay, intersect_cylinder, intersect_quad, intersect_sphere,
+    intersect_triangle, safe_inverse,
 };
 use crate::packet::Lanes;
 
@@ -94,7 +94,7 @@ impl RayLanes {
             t_near = t_near.max((near - o) * inv);
             t_far = t_far.min((far - o) * inv);
         }
-        (t_near, t_near.cmple(t_far).bitmask())
+        (t_near, t_near.cmple(t_far * ROBUST_FAR).bitmask())
     }
 }
 
@@ -131,17 +131,17 @@ impl CpuScene<'_> {
         }
     }
 
-    /// Nearest hit on primitive `i` (a shape or a triangle), updating `hit`. Twin of WGSL
-    /// `intersect_primitive`.
+    /// Nearest hit on primitive `i` (a shape or a triangle), updating `hit`; `sheared` is
+    /// `ray` in ray space. Twin of WGSL `intersect_primitive`.
     #[inline(always)]
-    pub fn intersect_primitive(&self, i: u32, ray: &Ray, hit: &mut Hit) {
+    pub fn intersect_primitive(&self, i: u32, ray: &Ray, sheared: &ShearedRay, hit: &mut Hit) {
         let p = &self.primitives[i as usize];
         if p.triangle == NO_TRIANGLE {
             self.intersect_shape(p.object, ray, hit);
             return;
         }
-        let [v0, e1, e2] = [p.v0, p.e1, p.e2].map(Vec3::from);
-        let (t, b1, b2) = intersect_triangle_edges(v0, e1, e2, ray, hit.t);
+        let [v0, v1, v2] = [p.v0, p.v1, p.v2].map(Vec3::from);
+        let (t, b1, b2) = intersect_triangle(v0, v1, v2, sheared, hit.t);
         if t < hit.t {
             *hit = Hit {
                 t,
@@ -202,6 +202,7 @@ impl<'a> Tracer<'a> {
             let walk = Walk {
                 scene: self.scene,
                 ray,
+                sheared: ShearedRay::new(ray),
                 lanes: &lanes,
                 any_hit,
             };
@@ -215,6 +216,8 @@ impl<'a> Tracer<'a> {
 pub(crate) struct Walk<'a> {
     pub scene: &'a CpuScene<'a>,
     pub ray: &'a Ray,
+    /// The ray in ray space, for the triangle tests.
+    pub sheared: ShearedRay,
     pub lanes: &'a RayLanes,
     pub any_hit: bool,
 }
@@ -249,7 +252,8 @@ impl Walk<'_> {
                 let count = n.count[lane] & !SHAPE_LEAF;
                 if count > 0 && t < hit.t {
                     for i in n.first[lane]..n.first[lane] + count {
-                        self.scene.intersect_primitive(i, self.ray, hit);
+                        self.scene
+                            .intersect_primitive(i, self.ray, &self.sheared, hit);
                     }
                     if self.any_hit && hit.object != u32::MAX {
                         return;
@@ -296,7 +300,7 @@ pub(crate) mod tests {
 
     use super::{Hit, Tracer};
     use crate::cpu_scene::CpuScene;
-    use crate::intersect::{Ray, intersect_triangle_edges};
+    use crate::intersect::{Ray, ShearedRay, intersect_triangle};
 
     /// The scene of `objects`, prepared.
     pub(crate) fn prepare(objects: Vec<Object>) -> PreparedScene {
@@ -314,7 +318,7 @@ pub(crate) mod tests {
             }
             for tri in o.first_triangle..o.first_triangle + o.triangle_count {
                 let [v0, v1, v2] = scene.triangle(tri);
-                let (t, b1, b2) = intersect_triangle_edges(v0, v1 - v0, v2 - v0, ray, hit.t);
+                let (t, b1, b2) = intersect_triangle(v0, v1, v2, &ShearedRay::new(ray), hit.t);
                 if t < hit.t {
                     hit = Hit {
                         t,

@@ -6,6 +6,13 @@ use glam::Vec3;
 /// Distance returned when there is no hit (WGSL `MISS`).
 pub const MISS: f32 = 3.0e38;
 
+/// Growth of a box's far distance that makes the slab test conservative: `1 + 2 gamma(3)`,
+/// with `gamma(n) = n eps / (1 - n eps)` for f32's `eps = 2^-24` (Ize, "Robust BVH Ray
+/// Traversal", JCGT 2013; pbrt-v4). Without it, a ray that meets a box exactly at its
+/// boundary (a triangle's edge at the box's extreme) can be found outside by a rounding of
+/// `t_near` past `t_far`, and the triangle it hits is never tested. Twin of WGSL `ROBUST_FAR`.
+pub const ROBUST_FAR: f32 = 1.000_000_4;
+
 /// A ray with a unit direction.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ray {
@@ -132,36 +139,96 @@ pub fn intersect_cylinder(
     t_best
 }
 
-/// Moller-Trumbore on corner `v0` and the edges `e1 = v1 - v0`, `e2 = v2 - v0`; returns
-/// `(t, b1, b2)` with the barycentrics of vertices 1 and 2. Twin of WGSL
-/// `intersect_triangle_edges`.
+/// A ray in the form the watertight triangle test wants (Woop, Benthin and Wald, "Watertight
+/// Ray/Triangle Intersection", JCGT 2013): a point `p` maps to ray space as
+/// `(row_x . (p - origin), row_y . (p - origin), row_z . (p - origin))`, where the direction's
+/// largest axis becomes z and a shear turns the direction into +z. The rows are the shear's,
+/// so that every ray applies them with the same arithmetic. Twin of WGSL `ShearedRay`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShearedRay {
+    /// The ray's start.
+    pub origin: Vec3,
+    /// First row of the shear: unit x' minus the direction's x'/z' times unit z'.
+    pub row_x: Vec3,
+    /// Second row.
+    pub row_y: Vec3,
+    /// Third row: unit z' over the direction's z'.
+    pub row_z: Vec3,
+}
+
+impl ShearedRay {
+    /// The ray space of `ray`. Twin of WGSL `sheared_ray`.
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> Self {
+        let d = ray.dir;
+        let a = d.abs();
+        let kz = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        let (mut row_x, mut row_y, mut row_z) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+        row_x[kx] = 1.0;
+        row_x[kz] = -d[kx] / d[kz];
+        row_y[ky] = 1.0;
+        row_y[kz] = -d[ky] / d[kz];
+        row_z[kz] = 1.0 / d[kz];
+        Self {
+            origin: ray.origin,
+            row_x,
+            row_y,
+            row_z,
+        }
+    }
+
+    /// `p` in ray space. Fused multiply-adds in a fixed order: a vertex shared by several
+    /// triangles gets the same coordinates in each of their tests.
+    #[inline(always)]
+    fn to_ray_space(&self, p: Vec3) -> Vec3 {
+        let q = p - self.origin;
+        let row = |r: Vec3| r.z.mul_add(q.z, r.y.mul_add(q.y, r.x * q.x));
+        Vec3::new(row(self.row_x), row(self.row_y), row(self.row_z))
+    }
+}
+
+/// `a b - c d` with one rounding's error at most (Kahan's algorithm on fused multiply-adds),
+/// so its sign is the exact product difference's. Twin of WGSL `difference_of_products`.
 #[inline(always)]
-pub fn intersect_triangle_edges(
+pub fn difference_of_products(a: f32, b: f32, c: f32, d: f32) -> f32 {
+    let cd = c * d;
+    let error = (-c).mul_add(d, cd);
+    a.mul_add(b, -cd) + error
+}
+
+/// The watertight triangle test: returns `(t, b1, b2)` with the barycentrics of vertices 1
+/// and 2, or `t` = [`MISS`]. Each edge function's sign is exact given the vertices' ray-space
+/// coordinates, and those are the same in every triangle that shares the vertex, so a ray
+/// through an edge shared by two triangles hits one of them (both, when it passes exactly
+/// through the edge): no ray leaks through a closed mesh. Twin of WGSL `intersect_triangle`.
+#[inline(always)]
+pub fn intersect_triangle(
     v0: Vec3,
-    e1: Vec3,
-    e2: Vec3,
-    ray: &Ray,
+    v1: Vec3,
+    v2: Vec3,
+    ray: &ShearedRay,
     t_max: f32,
 ) -> (f32, f32, f32) {
-    let p = ray.dir.cross(e2);
-    let det = e1.dot(p);
-    if det.abs() < 1e-20 {
+    let [p0, p1, p2] = [v0, v1, v2].map(|v| ray.to_ray_space(v));
+    let e0 = difference_of_products(p1.x, p2.y, p1.y, p2.x);
+    let e1 = difference_of_products(p2.x, p0.y, p2.y, p0.x);
+    let e2 = difference_of_products(p0.x, p1.y, p0.y, p1.x);
+    let inside = !((e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0));
+    let det = e0 + e1 + e2;
+    if !inside || det == 0.0 {
         return (MISS, 0.0, 0.0);
     }
     let inv_det = 1.0 / det;
-    let s = ray.origin - v0;
-    let b1 = s.dot(p) * inv_det;
-    if !(0.0..=1.0).contains(&b1) {
-        return (MISS, 0.0, 0.0);
-    }
-    let q = s.cross(e1);
-    let b2 = ray.dir.dot(q) * inv_det;
-    if b2 < 0.0 || b1 + b2 > 1.0 {
-        return (MISS, 0.0, 0.0);
-    }
-    let t = e2.dot(q) * inv_det;
+    let t = (e0 * p0.z + e1 * p1.z + e2 * p2.z) * inv_det;
     if !(t > 0.0 && t < t_max) {
         return (MISS, 0.0, 0.0);
     }
-    (t, b1, b2)
+    (t, e1 * inv_det, e2 * inv_det)
 }

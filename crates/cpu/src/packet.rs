@@ -21,8 +21,8 @@ use pathlight_core::gpu_types::{
 use crate::bvh::{Entry, Hit, RayLanes, Tracer, Walk};
 use crate::cpu_scene::CpuScene;
 use crate::intersect::{
-    Ray, intersect_cylinder, intersect_quad, intersect_sphere, intersect_triangle_edges,
-    safe_inverse,
+    ROBUST_FAR, Ray, ShearedRay, intersect_cylinder, intersect_quad, intersect_sphere,
+    intersect_triangle, safe_inverse,
 };
 
 /// Rays per packet.
@@ -64,6 +64,8 @@ struct PacketRays {
     origin: [[f32; PACKET]; 3],
     dir: [[f32; PACKET]; 3],
     inv_dir: [[f32; PACKET]; 3],
+    /// The rows of each ray's shear into ray space ([`ShearedRay`]), per row and axis.
+    shear: [[[f32; PACKET]; 3]; 3],
 }
 
 impl PacketRays {
@@ -73,16 +75,40 @@ impl PacketRays {
             origin: [[0.0; PACKET]; 3],
             dir: [[1.0; PACKET]; 3],
             inv_dir: [[1.0; PACKET]; 3],
+            shear: [[[0.0; PACKET]; 3]; 3],
         };
         for (l, ray) in packet.rays.iter().enumerate() {
             let inv = safe_inverse(ray.dir);
+            let sheared = ShearedRay::new(ray);
+            let rows = [sheared.row_x, sheared.row_y, sheared.row_z];
             for axis in 0..3 {
                 rays.origin[axis][l] = ray.origin[axis];
                 rays.dir[axis][l] = ray.dir[axis];
                 rays.inv_dir[axis][l] = inv[axis];
+                for (row, r) in rows.iter().enumerate() {
+                    rays.shear[row][axis][l] = r[axis];
+                }
             }
         }
         rays
+    }
+
+    /// Ray `l` in ray space.
+    #[inline(always)]
+    fn sheared(&self, l: usize) -> ShearedRay {
+        let row = |r: usize| {
+            Vec3::new(
+                self.shear[r][0][l],
+                self.shear[r][1][l],
+                self.shear[r][2][l],
+            )
+        };
+        ShearedRay {
+            origin: Vec3::new(self.origin[0][l], self.origin[1][l], self.origin[2][l]),
+            row_x: row(0),
+            row_y: row(1),
+            row_z: row(2),
+        }
     }
 
     #[inline(always)]
@@ -157,7 +183,7 @@ impl PacketHits {
             f32::from_bits(blend(new.to_bits(), old.to_bits(), take))
         };
         for l in 0..PACKET {
-            let (t, b1, b2) = shape.intersect(&rays.ray(l), self.t[l]);
+            let (t, b1, b2) = shape.intersect(rays, l, self.t[l]);
             let take = (lanes >> l) & 1 != 0 && t < self.t[l];
             self.t[l] = blend_f(t, self.t[l], take);
             self.b1[l] = blend_f(b1, self.b1[l], take);
@@ -180,8 +206,9 @@ impl PacketHits {
 
 /// A shape a packet's rays are tested against, one by one ([`crate::intersect`]'s tests).
 trait ShapeTest {
-    /// The hit `(t, b1, b2)` of `ray` in `(0, t_max)`, `t` = [`crate::intersect::MISS`] for none.
-    fn intersect(&self, ray: &Ray, t_max: f32) -> (f32, f32, f32);
+    /// The hit `(t, b1, b2)` of ray `l` of `rays` in `(0, t_max)`, `t` =
+    /// [`crate::intersect::MISS`] for none.
+    fn intersect(&self, rays: &PacketRays, l: usize, t_max: f32) -> (f32, f32, f32);
 }
 
 /// A quad: corner and edges.
@@ -193,36 +220,40 @@ struct Sphere(Vec3, f32);
 /// A cylinder: axis ends, radius, whether capped.
 struct Cylinder(Vec3, Vec3, f32, bool);
 
-/// A triangle: first corner and the two edges from it.
+/// A triangle: its corners.
 struct Triangle([Vec3; 3]);
 
 impl ShapeTest for Quad {
     #[inline(always)]
-    fn intersect(&self, ray: &Ray, t_max: f32) -> (f32, f32, f32) {
-        intersect_quad(self.0, self.1, self.2, ray, t_max)
+    fn intersect(&self, rays: &PacketRays, l: usize, t_max: f32) -> (f32, f32, f32) {
+        intersect_quad(self.0, self.1, self.2, &rays.ray(l), t_max)
     }
 }
 
 impl ShapeTest for Sphere {
     #[inline(always)]
-    fn intersect(&self, ray: &Ray, t_max: f32) -> (f32, f32, f32) {
-        (intersect_sphere(self.0, self.1, ray, t_max), 0.0, 0.0)
+    fn intersect(&self, rays: &PacketRays, l: usize, t_max: f32) -> (f32, f32, f32) {
+        (
+            intersect_sphere(self.0, self.1, &rays.ray(l), t_max),
+            0.0,
+            0.0,
+        )
     }
 }
 
 impl ShapeTest for Cylinder {
     #[inline(always)]
-    fn intersect(&self, ray: &Ray, t_max: f32) -> (f32, f32, f32) {
-        let t = intersect_cylinder(self.0, self.1, self.2, self.3, ray, t_max);
+    fn intersect(&self, rays: &PacketRays, l: usize, t_max: f32) -> (f32, f32, f32) {
+        let t = intersect_cylinder(self.0, self.1, self.2, self.3, &rays.ray(l), t_max);
         (t, 0.0, 0.0)
     }
 }
 
 impl ShapeTest for Triangle {
     #[inline(always)]
-    fn intersect(&self, ray: &Ray, t_max: f32) -> (f32, f32, f32) {
-        let [v0, e1, e2] = self.0;
-        intersect_triangle_edges(v0, e1, e2, ray, t_max)
+    fn intersect(&self, rays: &PacketRays, l: usize, t_max: f32) -> (f32, f32, f32) {
+        let [v0, v1, v2] = self.0;
+        intersect_triangle(v0, v1, v2, &rays.sheared(l), t_max)
     }
 }
 
@@ -378,7 +409,7 @@ impl PacketWalk<'_> {
                 t_near = max(t_near, min(t0, t1));
                 t_far = min(t_far, max(t0, t1));
             }
-            let inside = (lanes >> l) & 1 != 0 && t_near <= t_far;
+            let inside = (lanes >> l) & 1 != 0 && t_near <= t_far * ROBUST_FAR;
             entered |= Lanes::from(inside) << l;
             near[l] = if inside { t_near } else { f32::INFINITY };
         }
@@ -403,7 +434,7 @@ impl PacketWalk<'_> {
             let lanes = lanes & hits.searching;
             let p = &self.scene.primitives[i as usize];
             if p.triangle != NO_TRIANGLE {
-                let triangle = Triangle([p.v0, p.e1, p.e2].map(Vec3::from));
+                let triangle = Triangle([p.v0, p.v1, p.v2].map(Vec3::from));
                 hits.test(rays, lanes, p.object, p.triangle, &triangle);
                 continue;
             }
@@ -441,6 +472,7 @@ impl PacketWalk<'_> {
         let walk = Walk {
             scene: self.scene,
             ray: &ray,
+            sheared: self.rays.sheared(lane),
             lanes: &lanes,
             any_hit: self.any_hit,
         };

@@ -68,53 +68,53 @@ fn intersect_shape(i: u32, o: Object, ray: Ray, hit: ptr<function, Hit>) {
     }
 }
 
-// Hit on triangle `triangle` (its corner and edges) of mesh object `object`, if nearer than
-// `hit`.
-fn hit_triangle(object: u32, triangle: u32, v0: vec3f, e1: vec3f, e2: vec3f, ray: Ray, hit: ptr<function, Hit>) {
-    let r = intersect_triangle_edges(v0, e1, e2, ray, (*hit).t);
+// Hit on triangle `triangle` (its corners) of mesh object `object`, if nearer than `hit`.
+fn hit_triangle(object: u32, triangle: u32, v0: vec3f, v1: vec3f, v2: vec3f, ray: ShearedRay, hit: ptr<function, Hit>) {
+    let r = intersect_triangle(v0, v1, v2, ray, (*hit).t);
     if r.x < (*hit).t {
         *hit = Hit(r.x, object, triangle, r.y, r.z);
     }
 }
 
-// Nearest hit on primitive `i`, a shape or a triangle, updating `hit`.
+// Nearest hit on primitive `i`, a shape or a triangle, updating `hit`; `sheared` is `ray` in
+// ray space.
 // CPU twin: `CpuScene::intersect_primitive`.
-fn intersect_primitive(i: u32, ray: Ray, hit: ptr<function, Hit>) {
+fn intersect_primitive(i: u32, ray: Ray, sheared: ShearedRay, hit: ptr<function, Hit>) {
     let p = primitives[i];
     if p.triangle == NO_TRIANGLE {
         intersect_shape(p.object, objects[p.object], ray, hit);
         return;
     }
-    hit_triangle(p.object, p.triangle, p.v0, p.e1, p.e2, ray, hit);
+    hit_triangle(p.object, p.triangle, p.v0, p.v1, p.v2, sheared, hit);
 }
 
 // Nearest hit among primitives `first .. first + count`, all triangles.
-fn intersect_triangles(first: u32, count: u32, ray: Ray, hit: ptr<function, Hit>) {
+fn intersect_triangles(first: u32, count: u32, ray: ShearedRay, hit: ptr<function, Hit>) {
     for (var i = first; i < first + count; i++) {
         let p = primitives[i];
-        hit_triangle(p.object, p.triangle, p.v0, p.e1, p.e2, ray, hit);
+        hit_triangle(p.object, p.triangle, p.v0, p.v1, p.v2, ray, hit);
     }
 }
 
 // Nearest hit among the triangles of mesh object `i`, read from `vertices`.
-fn intersect_mesh(i: u32, o: Object, ray: Ray, hit: ptr<function, Hit>) {
+fn intersect_mesh(i: u32, o: Object, ray: ShearedRay, hit: ptr<function, Hit>) {
     for (var tri = o.first_triangle; tri < o.first_triangle + o.triangle_count; tri++) {
         let v0 = vertices[3u * tri].position;
-        let e1 = vertices[3u * tri + 1u].position - v0;
-        let e2 = vertices[3u * tri + 2u].position - v0;
-        hit_triangle(i, tri, v0, e1, e2, ray, hit);
+        let v1 = vertices[3u * tri + 1u].position;
+        let v2 = vertices[3u * tri + 2u].position;
+        hit_triangle(i, tri, v0, v1, v2, ray, hit);
     }
 }
 
 // The slower `ACCEL` schemes: every object in turn.
-fn intersect_linear(ray: Ray, inv_dir: vec3f, object_count: u32, any_hit: bool, hit: ptr<function, Hit>) {
+fn intersect_linear(ray: Ray, sheared: ShearedRay, inv_dir: vec3f, object_count: u32, any_hit: bool, hit: ptr<function, Hit>) {
     for (var i = 0u; i < object_count; i++) {
         let o = objects[i];
         if o.kind != KIND_MESH {
             intersect_shape(i, o, ray, hit);
         } else if ACCEL == ACCEL_BRUTE_FORCE
             || intersect_aabb(Aabb(o.a.xyz, o.b.xyz), ray.origin, inv_dir, (*hit).t) != MISS {
-            intersect_mesh(i, o, ray, hit);
+            intersect_mesh(i, o, sheared, hit);
         }
         if any_hit && (*hit).object != NO_HIT {
             return;
@@ -135,7 +135,7 @@ fn enter_children(n: WideNode, origin: vec3f, inv_dir: vec3f, backwards: vec3<bo
     let far_z = (select(n.hi_z, n.lo_z, backwards.z) - origin.z) * inv_dir.z;
     let t_near = max(max(near_x, near_y), max(near_z, vec4f(0.0)));
     let t_far = min(min(far_x, far_y), min(far_z, vec4f(t_max)));
-    return select(vec4f(MISS), t_near, t_near <= t_far);
+    return select(vec4f(MISS), t_near, t_near <= t_far * ROBUST_FAR);
 }
 
 // Orders the pairs (a, b) by key: afterwards *ka <= *kb.
@@ -158,8 +158,9 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
         return hit;
     }
     let inv_dir = safe_inverse(ray.dir);
+    let sheared = sheared_ray(ray);
     if ACCEL != ACCEL_BVH {
-        intersect_linear(ray, inv_dir, object_count, any_hit, &hit);
+        intersect_linear(ray, sheared, inv_dir, object_count, any_hit, &hit);
         return hit;
     }
     let backwards = inv_dir < vec3f(0.0);
@@ -180,7 +181,7 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
                 let first = n.first[lane];
                 let end = first + (n.count[lane] & ~SHAPE_LEAF);
                 for (var i = first; i < end; i++) {
-                    intersect_primitive(i, ray, &hit);
+                    intersect_primitive(i, ray, sheared, &hit);
                 }
             }
             if any_hit && hit.object != NO_HIT {
@@ -234,7 +235,7 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
             }
             let node = (next & ~LEAF) >> 2u;
             let lane = next & 3u;
-            intersect_triangles(nodes[node].first[lane], nodes[node].count[lane], ray, &hit);
+            intersect_triangles(nodes[node].first[lane], nodes[node].count[lane], sheared, &hit);
             if any_hit && hit.object != NO_HIT {
                 return hit;
             }

@@ -4,6 +4,11 @@
 
 const MISS: f32 = 3.0e38;
 
+// Growth of a box's far distance that makes the slab test conservative: 1 + 2 gamma(3) for
+// f32 (Ize, "Robust BVH Ray Traversal", JCGT 2013), so a ray touching a box's boundary enters.
+// CPU twin: `ROBUST_FAR`.
+const ROBUST_FAR: f32 = 1.0000004;
+
 struct Ray {
     origin: vec3f,
     dir: vec3f,
@@ -21,7 +26,7 @@ fn intersect_aabb(b: Aabb, origin: vec3f, inv_dir: vec3f, t_max: f32) -> f32 {
     let t1 = (b.max - origin) * inv_dir;
     let t_near = max(max(min(t0.x, t1.x), min(t0.y, t1.y)), max(min(t0.z, t1.z), 0.0));
     let t_far = min(min(max(t0.x, t1.x), max(t0.y, t1.y)), min(max(t0.z, t1.z), t_max));
-    return select(MISS, t_near, t_near <= t_far);
+    return select(MISS, t_near, t_near <= t_far * ROBUST_FAR);
 }
 
 // 1 / d with zero components replaced by a tiny value of the same sign.
@@ -122,29 +127,80 @@ fn intersect_cylinder(p0: vec3f, p1: vec3f, radius: f32, caps: bool, ray: Ray, t
     return t_best;
 }
 
-// Moller-Trumbore on corner v0 and edges e1 = v1 - v0, e2 = v2 - v0; returns (t, b1, b2)
-// with barycentrics of vertices 1 and 2.
-// CPU twin: `intersect_triangle_edges`.
-fn intersect_triangle_edges(v0: vec3f, e1: vec3f, e2: vec3f, ray: Ray, t_max: f32) -> vec3f {
-    let p = cross(ray.dir, e2);
-    let det = dot(e1, p);
-    if abs(det) < 1e-20 {
+// A ray in the form the watertight triangle test wants (Woop, Benthin and Wald, "Watertight
+// Ray/Triangle Intersection", JCGT 2013): a point p maps to ray space as the dot products of
+// p - origin with the three rows, which make the direction's largest axis z and shear the
+// direction onto +z.
+// CPU twin: `ShearedRay`.
+struct ShearedRay {
+    origin: vec3f,
+    row_x: vec3f,
+    row_y: vec3f,
+    row_z: vec3f,
+}
+
+// CPU twin: `ShearedRay::new`.
+fn sheared_ray(ray: Ray) -> ShearedRay {
+    let d = ray.dir;
+    let a = abs(d);
+    var kz = 2u;
+    if a.x >= a.y && a.x >= a.z {
+        kz = 0u;
+    } else if a.y >= a.z {
+        kz = 1u;
+    }
+    let kx = (kz + 1u) % 3u;
+    let ky = (kz + 2u) % 3u;
+    var row_x = vec3f(0.0);
+    var row_y = vec3f(0.0);
+    var row_z = vec3f(0.0);
+    row_x[kx] = 1.0;
+    row_x[kz] = -d[kx] / d[kz];
+    row_y[ky] = 1.0;
+    row_y[kz] = -d[ky] / d[kz];
+    row_z[kz] = 1.0 / d[kz];
+    return ShearedRay(ray.origin, row_x, row_y, row_z);
+}
+
+// `p` in ray space, with fused multiply-adds in a fixed order so that a vertex shared by
+// several triangles gets the same coordinates in each of their tests.
+fn to_ray_space(ray: ShearedRay, p: vec3f) -> vec3f {
+    let q = p - ray.origin;
+    return vec3f(
+        fma(ray.row_x.z, q.z, fma(ray.row_x.y, q.y, ray.row_x.x * q.x)),
+        fma(ray.row_y.z, q.z, fma(ray.row_y.y, q.y, ray.row_y.x * q.x)),
+        fma(ray.row_z.z, q.z, fma(ray.row_z.y, q.y, ray.row_z.x * q.x)),
+    );
+}
+
+// a b - c d with one rounding's error at most (Kahan's algorithm), so its sign is exact.
+// CPU twin: `difference_of_products`.
+fn difference_of_products(a: f32, b: f32, c: f32, d: f32) -> f32 {
+    let cd = c * d;
+    let error = fma(-c, d, cd);
+    return fma(a, b, -cd) + error;
+}
+
+// The watertight triangle test; returns (t, b1, b2) with the barycentrics of vertices 1 and
+// 2. Edge function signs are exact given the ray-space corners, which are the same in every
+// triangle sharing a corner, so no ray passes between two triangles of a mesh.
+// CPU twin: `intersect_triangle`.
+fn intersect_triangle(v0: vec3f, v1: vec3f, v2: vec3f, ray: ShearedRay, t_max: f32) -> vec3f {
+    let p0 = to_ray_space(ray, v0);
+    let p1 = to_ray_space(ray, v1);
+    let p2 = to_ray_space(ray, v2);
+    let e0 = difference_of_products(p1.x, p2.y, p1.y, p2.x);
+    let e1 = difference_of_products(p2.x, p0.y, p2.y, p0.x);
+    let e2 = difference_of_products(p0.x, p1.y, p0.y, p1.x);
+    let inside = !((e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0));
+    let det = e0 + e1 + e2;
+    if !inside || det == 0.0 {
         return vec3f(MISS, 0.0, 0.0);
     }
     let inv_det = 1.0 / det;
-    let s = ray.origin - v0;
-    let b1 = dot(s, p) * inv_det;
-    if b1 < 0.0 || b1 > 1.0 {
-        return vec3f(MISS, 0.0, 0.0);
-    }
-    let q = cross(s, e1);
-    let b2 = dot(ray.dir, q) * inv_det;
-    if b2 < 0.0 || b1 + b2 > 1.0 {
-        return vec3f(MISS, 0.0, 0.0);
-    }
-    let t = dot(e2, q) * inv_det;
+    let t = (e0 * p0.z + e1 * p1.z + e2 * p2.z) * inv_det;
     if !(t > 0.0 && t < t_max) {
         return vec3f(MISS, 0.0, 0.0);
     }
-    return vec3f(t, b1, b2);
+    return vec3f(t, e1 * inv_det, e2 * inv_det);
 }

@@ -60,15 +60,15 @@ struct Vertex {
     v: f32,
 }
 
-// A primitive of the BVH, in leaf order: a triangle for the intersection test (corner 0 and
-// the edges to corners 1 and 2; `triangle` is its index in `vertices`) or, with `triangle`
-// NO_TRIANGLE, the whole shape `object`. Host: `GpuPrimitive`.
+// A primitive of the BVH, in leaf order: a triangle with its corners (`triangle` is its
+// index in `vertices`) or, with `triangle` NO_TRIANGLE, the whole shape `object`. Host:
+// `GpuPrimitive`.
 struct Primitive {
     v0: vec3f,
     object: u32,
-    e1: vec3f,
+    v1: vec3f,
     triangle: u32,
-    e2: vec3f,
+    v2: vec3f,
     pad: u32,
 }
 

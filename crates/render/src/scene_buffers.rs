@@ -55,9 +55,9 @@ fn geometry_contents(geometry: &Geometry) -> [(usize, &'static str, &[u8]); 3] {
     const PLACEHOLDER: [GpuPrimitive; 1] = [GpuPrimitive {
         v0: [0.0; 3],
         object: 0,
-        e1: [0.0; 3],
+        v1: [0.0; 3],
         triangle: 0,
-        e2: [0.0; 3],
+        v2: [0.0; 3],
         pad: 0,
     }];
     let primitives = if geometry.primitives.is_empty() {

@@ -132,7 +132,7 @@ fn host_structs_match_their_wgsl_declarations() {
         m,
         "Primitive",
         GpuPrimitive,
-        [v0, object, e1, triangle, e2, pad]
+        [v0, object, v1, triangle, v2, pad]
     );
     assert_layout!(
         m,

@@ -59,7 +59,10 @@ impl Revolution {
                 y: height,
             } = catmull_rom(&self.profile, t);
             for column in 0..columns {
-                let phi = std::f32::consts::TAU * column as f32 / self.segments as f32;
+                // The seam's last column is the first one again, exactly: cos and sin of 2 pi
+                // in f32 are not 1 and 0, and the gap between them would let rays through.
+                let phi =
+                    std::f32::consts::TAU * (column % self.segments) as f32 / self.segments as f32;
                 let radial = tangent * phi.cos() + bitangent * phi.sin();
                 mesh.positions
                     .push(self.base + axis * height + radial * radius.max(0.0));
@@ -113,6 +116,31 @@ mod tests {
         assert!(catmull_rom(&points, 0.0).distance(points[0]) < 1e-6);
         assert!(catmull_rom(&points, 0.5).distance(points[1]) < 1e-6);
         assert!(catmull_rom(&points, 1.0).distance(points[2]) < 1e-6);
+    }
+
+    #[test]
+    fn the_seam_columns_are_the_same_points() {
+        let mesh = Revolution {
+            base: Vec3::ZERO,
+            axis: Vec3::new(0.3, 1.0, 0.2).normalize(),
+            profile: vec![
+                Vec2::new(0.5, 0.0),
+                Vec2::new(0.7, 0.5),
+                Vec2::new(0.3, 1.0),
+            ],
+            segments: 37,
+            rings: 9,
+            cap_bottom: true,
+        }
+        .to_mesh();
+        for ring in 0..=9 {
+            let first = ring * 38;
+            assert_eq!(
+                mesh.positions[first],
+                mesh.positions[first + 37],
+                "ring {ring}"
+            );
+        }
     }
 
     #[test]
