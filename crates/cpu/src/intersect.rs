@@ -187,7 +187,7 @@ impl ShearedRay {
     /// `p` in ray space. Fused multiply-adds in a fixed order: a vertex shared by several
     /// triangles gets the same coordinates in each of their tests.
     #[inline(always)]
-    fn to_ray_space(&self, p: Vec3) -> Vec3 {
+    fn in_ray_space(&self, p: Vec3) -> Vec3 {
         let q = p - self.origin;
         let row = |r: Vec3| r.z.mul_add(q.z, r.y.mul_add(q.y, r.x * q.x));
         Vec3::new(row(self.row_x), row(self.row_y), row(self.row_z))
@@ -216,7 +216,7 @@ pub fn intersect_triangle(
     ray: &ShearedRay,
     t_max: f32,
 ) -> (f32, f32, f32) {
-    let [p0, p1, p2] = [v0, v1, v2].map(|v| ray.to_ray_space(v));
+    let [p0, p1, p2] = [v0, v1, v2].map(|v| ray.in_ray_space(v));
     let e0 = difference_of_products(p1.x, p2.y, p1.y, p2.x);
     let e1 = difference_of_products(p2.x, p0.y, p2.y, p0.x);
     let e2 = difference_of_products(p0.x, p1.y, p0.y, p1.x);
