@@ -140,12 +140,12 @@ fn measure(
     started: Instant,
 ) -> anyhow::Result<Measurement> {
     let build_start = Instant::now();
-    let prepared = PreparedScene::new(scene);
+    let prepared = PreparedScene::new(scene)?;
     let bvh_build_s = build_start.elapsed().as_secs_f64();
     let triangles = prepared.geometry.triangle_count();
     let mut renderer = device.renderer(scene, &prepared, accel)?;
     let traversal_stack = renderer.traversal_stack();
-    let time_limit = Duration::from_secs_f64(args.time_limit.max(0.0));
+    let time_limit = args.time_limit;
 
     // The first frame is never timed: it includes the pipeline's first use.
     renderer.queue_frame()?;

@@ -1,6 +1,7 @@
 //! Command-line interface (clap derive; doc comments are the help text).
 
 use std::path::PathBuf;
+use std::time::Duration;
 
 use clap::{Parser, Subcommand, ValueEnum};
 
@@ -133,8 +134,8 @@ pub struct BenchArgs {
     pub warmup: u32,
     /// Stop the warm-up, and the timed frames, after this many seconds each (at least one
     /// frame is always timed), so slow adapters finish.
-    #[arg(long, default_value_t = 20.0, value_name = "SECONDS")]
-    pub time_limit: f64,
+    #[arg(long, default_value = "20s", value_name = "DURATION", value_parser = duration)]
+    pub time_limit: Duration,
     /// How the nearest hit is found (GPU backend).
     #[arg(long, value_enum, default_value_t = AccelArg::Bvh)]
     pub accel: AccelArg,
@@ -204,5 +205,47 @@ fn positive_strength(text: &str) -> Result<f32, NotPositive> {
     match text.parse::<f32>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
         _ => Err(NotPositive(text.to_owned())),
+    }
+}
+
+/// A command-line duration that is not a finite, non-negative number of seconds, minutes or
+/// hours.
+#[derive(Debug, thiserror::Error)]
+#[error(
+    "{0:?} is not a duration: a number of seconds (`90`, `90s`), minutes (`10m`) or hours \
+     (`1.5h`), finite, from 0 to 10^9 seconds"
+)]
+pub struct BadDuration(String);
+
+/// Parses a duration: a number with an optional unit `s` (the default), `m` or `h`.
+pub fn duration(text: &str) -> Result<Duration, BadDuration> {
+    let bad = || BadDuration(text.to_owned());
+    let trimmed = text.trim();
+    let (number, unit) = match trimmed.char_indices().last() {
+        Some((i, 's')) => (&trimmed[..i], 1.0),
+        Some((i, 'm')) => (&trimmed[..i], 60.0),
+        Some((i, 'h')) => (&trimmed[..i], 3600.0),
+        _ => (trimmed, 1.0),
+    };
+    let seconds = number.trim().parse::<f64>().map_err(|_| bad())? * unit;
+    if !(0.0..=1e9).contains(&seconds) {
+        return Err(bad());
+    }
+    Ok(Duration::from_secs_f64(seconds))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn durations_read_units_and_refuse_nonsense() {
+        assert_eq!(duration("20").unwrap(), Duration::from_secs(20));
+        assert_eq!(duration("1.5h").unwrap(), Duration::from_secs(5400));
+        assert_eq!(duration("10m").unwrap(), Duration::from_secs(600));
+        assert_eq!(duration("0.25s").unwrap(), Duration::from_millis(250));
+        for bad in ["inf", "1e300", "nan", "-1", "", "m", "10x", "1e10"] {
+            assert!(duration(bad).is_err(), "{bad:?} was accepted");
+        }
     }
 }

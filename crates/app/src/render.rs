@@ -38,7 +38,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
 
 fn render_to_file(scene: &Scene, args: &RenderArgs) -> anyhow::Result<()> {
     let started = Instant::now();
-    let prepared = PreparedScene::new(scene);
+    let prepared = PreparedScene::new(scene)?;
     let device = Device::open(&args.device)?;
     let mut renderer = device.renderer(scene, &prepared, Accel::Bvh)?;
     let kind = match device {

@@ -298,6 +298,17 @@ fn bench_and_view_refuse_bad_options() {
         );
         assert!(err.contains("positive finite number"), "{strength}:\n{err}");
     }
+    // An infinite or absurd time limit panicked converting to a Duration.
+    for limit in ["inf", "1e300", "nan", "-1"] {
+        let output = pathlight(&["bench", "--backend", "cpu", "--time-limit", limit]);
+        let err = stderr(&output);
+        assert_eq!(
+            output.status.code(),
+            Some(2),
+            "{limit}: clap's usage error\n{err}"
+        );
+        assert!(err.contains("is not a duration"), "{limit}:\n{err}");
+    }
 }
 
 /// `--sampler` replaces the scene's sampler: `sobol` (the default) gives the image the scene

@@ -29,3 +29,16 @@ pub enum RenderError {
     #[error("GPU failure: {0}")]
     Gpu(String),
 }
+
+/// A scene whose geometry cannot be built into a BVH: a coordinate or a length that is not
+/// finite or lies beyond [`pathlight_scene::settings::MAX_COORDINATE`] (where boxes and
+/// areas would overflow). Scene files are checked when they load, with their line; this
+/// guards every other way a scene is made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("object {object:?}: {message}")]
+pub struct GeometryError {
+    /// The object's name.
+    pub object: String,
+    /// What is wrong, with the value.
+    pub message: String,
+}

@@ -11,10 +11,12 @@ use std::time::{Duration, Instant};
 use bytemuck::Zeroable;
 use glam::{Vec3, Vec3A};
 use obvhs::aabb::Aabb;
+use pathlight_scene::settings::MAX_COORDINATE;
 use pathlight_scene::{Object, Shape, TriangleMesh};
 use rayon::prelude::*;
 
 use crate::bvh;
+use crate::error::GeometryError;
 use crate::gpu_types::{
     FLAG_CAPS, FLAG_FLAT, GpuObject, GpuPrimitive, GpuVertex, GpuWideNode, KIND_CYLINDER,
     KIND_MESH, KIND_QUAD, KIND_SPHERE, NO_LIGHT, NO_TRIANGLE,
@@ -51,8 +53,15 @@ struct PrimitiveRef {
 }
 
 impl Geometry {
-    /// Builds the BVH over every primitive of `objects` and flattens them.
-    pub fn build(objects: &[Object]) -> Self {
+    /// Builds the BVH over every primitive of `objects` and flattens them; refuses
+    /// geometry that is not finite or beyond the coordinate limit.
+    pub fn build(objects: &[Object]) -> Result<Self, GeometryError> {
+        for object in objects {
+            check_shape(&object.shape).map_err(|message| GeometryError {
+                object: object.name.clone(),
+                message,
+            })?;
+        }
         let started = Instant::now();
         let mut shapes = Vec::with_capacity(objects.len());
         let mut refs = Vec::new();
@@ -106,7 +115,7 @@ impl Geometry {
             out.vertices.push(GpuVertex::zeroed());
         }
         out.build_time = started.elapsed();
-        out
+        Ok(out)
     }
 
     /// Triangle `i`'s corner positions (`i` in triangles of the vertex buffer).
@@ -200,6 +209,77 @@ impl Geometry {
                 primitive
             })
             .collect();
+    }
+}
+
+/// Why `shape` cannot be built, if it cannot: a value not finite or beyond
+/// [`MAX_COORDINATE`].
+fn check_shape(shape: &Shape) -> Result<(), String> {
+    let point = |what: &str, p: Vec3| {
+        if p.abs().cmple(Vec3::splat(MAX_COORDINATE)).all() {
+            Ok(())
+        } else {
+            Err(format!(
+                "{what} {p} is not finite or beyond +-{MAX_COORDINATE:e}"
+            ))
+        }
+    };
+    let length = |what: &str, r: f32| {
+        if r > 0.0 && r <= MAX_COORDINATE {
+            Ok(())
+        } else {
+            Err(format!("{what} {r} is not in (0, {MAX_COORDINATE:e}]"))
+        }
+    };
+    match shape {
+        Shape::Quad {
+            origin,
+            edge_u,
+            edge_v,
+        } => {
+            point("origin", *origin)?;
+            point("edge_u", *edge_u)?;
+            point("edge_v", *edge_v)
+        }
+        Shape::Sphere {
+            center,
+            radius,
+            texture_rotation,
+        } => {
+            point("center", *center)?;
+            length("radius", *radius)?;
+            if texture_rotation.is_finite() {
+                Ok(())
+            } else {
+                Err(format!("texture rotation {texture_rotation} is not finite"))
+            }
+        }
+        Shape::Cylinder { p0, p1, radius, .. } => {
+            point("p0", *p0)?;
+            point("p1", *p1)?;
+            length("radius", *radius)?;
+            if p0 == p1 {
+                return Err("its axis has no length (p0 = p1)".into());
+            }
+            Ok(())
+        }
+        Shape::Mesh(mesh) => {
+            for (i, p) in mesh.positions.iter().enumerate() {
+                point(&format!("vertex {i}"), *p)?;
+            }
+            let count = mesh.positions.len() as u32;
+            match mesh
+                .indices
+                .iter()
+                .position(|t| t.iter().any(|&i| i >= count))
+            {
+                Some(t) => Err(format!(
+                    "triangle {t} names vertex {:?}; the mesh has {count}",
+                    mesh.indices[t]
+                )),
+                None => Ok(()),
+            }
+        }
     }
 }
 
@@ -305,7 +385,8 @@ fn triangle_bounds(mesh: &TriangleMesh, t: usize) -> Aabb {
 mod tests {
     use glam::Vec3;
     use pathlight_scene::testing::{
-        coincident_triangles, degenerate_objects, object, random_mesh, random_objects, scene_of,
+        coincident_triangles, degenerate_objects, mesh_of, object, random_mesh, random_objects,
+        scene_of,
     };
     use pathlight_scene::{Object, Shape};
     use rand::SeedableRng;
@@ -423,18 +504,18 @@ mod tests {
     fn random_scenes_build_valid_trees() {
         let mut rng = StdRng::seed_from_u64(7);
         for count in [1, 2, 5, 40] {
-            validate(&Geometry::build(&random_objects(&mut rng, count)));
+            validate(&Geometry::build(&random_objects(&mut rng, count)).unwrap());
         }
         let big = vec![object(
             "big",
             Shape::Mesh(random_mesh(&mut rng, 20_000, Vec3::ZERO)),
         )];
-        validate(&Geometry::build(&big));
+        validate(&Geometry::build(&big).unwrap());
     }
 
     #[test]
     fn an_empty_scene_has_one_node_that_no_ray_enters() {
-        let g = Geometry::build(&[]);
+        let g = Geometry::build(&[]).unwrap();
         validate(&g);
         assert_eq!(g.nodes.len(), 1);
         assert!((0..4).all(|lane| !lane_used(&g.nodes[0], lane)));
@@ -448,8 +529,51 @@ mod tests {
 
     #[test]
     fn degenerate_and_coincident_triangles_build_valid_trees() {
-        validate(&Geometry::build(&degenerate_objects()));
-        validate(&Geometry::build(&coincident_triangles(5000)));
+        validate(&Geometry::build(&degenerate_objects()).unwrap());
+        validate(&Geometry::build(&coincident_triangles(5000)).unwrap());
+    }
+
+    /// Geometry whose boxes or areas would not be finite is refused before the BVH build
+    /// (obvhs panicked on it), naming the object; so is a triangle naming a vertex the mesh
+    /// does not have.
+    #[test]
+    fn geometry_that_would_overflow_is_refused_by_name() {
+        let triangle = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let mut nan = mesh_of(&[triangle]);
+        nan.positions[1].y = f32::NAN;
+        let mut huge = mesh_of(&[triangle]);
+        huge.positions[2] = Vec3::splat(1e38);
+        let mut dangling = mesh_of(&[triangle]);
+        dangling.indices[0][2] = 7;
+        let cases = [
+            Shape::Mesh(nan),
+            Shape::Mesh(huge),
+            Shape::Mesh(dangling),
+            Shape::Sphere {
+                center: Vec3::ZERO,
+                radius: f32::INFINITY,
+                texture_rotation: 0.0,
+            },
+            Shape::Quad {
+                origin: Vec3::splat(-3e38),
+                edge_u: Vec3::X,
+                edge_v: Vec3::Y,
+            },
+            Shape::Cylinder {
+                p0: Vec3::ZERO,
+                p1: Vec3::ZERO,
+                radius: 1.0,
+                caps: true,
+            },
+        ];
+        for shape in cases {
+            let objects = [
+                object("fine", Shape::Mesh(mesh_of(&[triangle]))),
+                object("bad", shape),
+            ];
+            let err = Geometry::build(&objects).expect_err("refused");
+            assert_eq!(err.object, "bad", "{err}");
+        }
     }
 
     #[test]
@@ -468,7 +592,7 @@ mod tests {
                 .num_threads(threads)
                 .build()
                 .expect("a thread pool")
-                .install(|| Geometry::build(&scene.objects))
+                .install(|| Geometry::build(&scene.objects).unwrap())
         };
         let (one, four) = (build_on(1), build_on(4));
         validate(&four);

@@ -16,7 +16,7 @@ pub mod renderer;
 pub mod shading;
 pub mod textures;
 
-pub use error::RenderError;
+pub use error::{GeometryError, RenderError};
 pub use film::Film;
 pub use geometry::Geometry;
 pub use prepared::PreparedScene;

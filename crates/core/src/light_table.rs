@@ -154,7 +154,7 @@ mod tests {
     #[test]
     fn entries_are_chosen_by_power_and_objects_point_at_them() {
         let scene = lit(Vec3::splat(2.0));
-        let geometry = Geometry::build(&scene.objects);
+        let geometry = Geometry::build(&scene.objects).unwrap();
         let shading = Shading::build(&scene, &geometry);
         // One entry per shape, one per mesh triangle; the grey sphere has none.
         assert_eq!(shading.light_count, 4);
@@ -192,7 +192,7 @@ mod tests {
     #[test]
     fn without_emission_or_area_the_table_is_a_placeholder() {
         let dark = lit(Vec3::ZERO);
-        let geometry = Geometry::build(&dark.objects);
+        let geometry = Geometry::build(&dark.objects).unwrap();
         let shading = Shading::build(&dark, &geometry);
         assert_eq!((shading.light_count, shading.lights.len()), (0, 1));
         assert!(shading.objects.iter().all(|o| o.light == NO_LIGHT));
@@ -204,7 +204,7 @@ mod tests {
             edge_u: Vec3::X,
             edge_v: Vec3::X,
         };
-        let geometry = Geometry::build(&flat.objects);
+        let geometry = Geometry::build(&flat.objects).unwrap();
         assert_eq!(Shading::build(&flat, &geometry).light_count, 0);
     }
 }

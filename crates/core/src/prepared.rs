@@ -4,6 +4,7 @@ use std::sync::Arc;
 
 use pathlight_scene::Scene;
 
+use crate::error::GeometryError;
 use crate::geometry::Geometry;
 use crate::shading::Shading;
 use crate::textures::Textures;
@@ -22,15 +23,16 @@ pub struct PreparedScene {
 }
 
 impl PreparedScene {
-    /// Builds the BVH and the buffers of `scene`.
-    pub fn new(scene: &Scene) -> Self {
-        let geometry = Geometry::build(&scene.objects);
+    /// Builds the BVH and the buffers of `scene`; refuses geometry that is not finite or
+    /// beyond the coordinate limit.
+    pub fn new(scene: &Scene) -> Result<Self, GeometryError> {
+        let geometry = Geometry::build(&scene.objects)?;
         let shading = Shading::build(scene, &geometry);
-        Self {
+        Ok(Self {
             geometry: Arc::new(geometry),
             textures: Arc::new(Textures::build(&scene.textures)),
             shading,
-        }
+        })
     }
 
     /// The shading of `scene`, whose objects must be this scene's (only their materials,

@@ -304,7 +304,7 @@ pub(crate) mod tests {
 
     /// The scene of `objects`, prepared.
     pub(crate) fn prepare(objects: Vec<Object>) -> PreparedScene {
-        PreparedScene::new(&scene_of(objects))
+        PreparedScene::new(&scene_of(objects)).unwrap()
     }
 
     /// The nearest hit over every object and every triangle, without the BVH.

@@ -42,7 +42,7 @@ fn render(name: &str, size: u32, spp: u32) -> Film {
 
 /// Renders `scene` on the CPU at `spp` with the path tracer compiled for `isa`.
 fn render_scene(scene: &Scene, spp: u32, isa: InstructionSet) -> Film {
-    let prepared = PreparedScene::new(scene);
+    let prepared = PreparedScene::new(scene).unwrap();
     let mut renderer = CpuRenderer::new(&prepared, &scene.camera, &scene.settings);
     renderer.set_instruction_set(isa).unwrap();
     while renderer.samples_done() < spp {
@@ -174,7 +174,7 @@ fn packets_trace_each_path_as_it_is_traced_alone() {
     scene.camera.width = size;
     scene.camera.height = size;
     let film = render_scene(&scene, spp, InstructionSet::best());
-    let prepared = PreparedScene::new(&scene);
+    let prepared = PreparedScene::new(&scene).unwrap();
     let params = GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
     let cpu_scene = CpuScene::new(&prepared);
     let mut tracer = Tracer::new(&cpu_scene);

@@ -20,7 +20,8 @@ const RAYS_PER_MESH: usize = 3_400_000;
 fn no_ray_passes_between_the_triangles_of_a_closed_mesh() {
     let mut total = 0;
     for (seed, (name, mesh)) in watertight_meshes().into_iter().enumerate() {
-        let prepared = PreparedScene::new(&scene_of(vec![object(name, Shape::Mesh(mesh.clone()))]));
+        let prepared =
+            PreparedScene::new(&scene_of(vec![object(name, Shape::Mesh(mesh.clone()))])).unwrap();
         let view = CpuScene::new(&prepared);
         let mut rng = StdRng::seed_from_u64(seed as u64);
         let rays = rays_at_shared_edges(&mut rng, &mesh, RAYS_PER_MESH);

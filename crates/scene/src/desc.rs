@@ -9,6 +9,8 @@ use std::collections::BTreeMap;
 use serde::Deserialize;
 use toml::Spanned;
 
+use crate::exact;
+
 /// A whole scene file.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -58,16 +60,18 @@ pub enum ColorSpace {
 #[serde(deny_unknown_fields)]
 pub struct CameraDesc {
     /// Eye position.
+    #[serde(deserialize_with = "exact::array")]
     pub position: [f32; 3],
     /// Point the camera looks at.
+    #[serde(deserialize_with = "exact::array")]
     pub look_at: [f32; 3],
     /// Up direction (need not be orthogonal to the view direction).
-    #[serde(default = "default_up")]
+    #[serde(default = "default_up", deserialize_with = "exact::array")]
     pub up: [f32; 3],
     /// Full vertical field of view in degrees.
     pub fov_y: f32,
     /// Image size in pixels, `[width, height]`.
-    #[serde(default = "default_resolution")]
+    #[serde(default = "default_resolution", deserialize_with = "exact::array")]
     pub resolution: [u32; 2],
 }
 
@@ -123,6 +127,7 @@ impl Default for RenderDesc {
 #[serde(deny_unknown_fields)]
 pub struct EnvironmentDesc {
     /// Linear RGB radiance.
+    #[serde(deserialize_with = "exact::array")]
     pub radiance: [f32; 3],
 }
 
@@ -131,11 +136,12 @@ pub struct EnvironmentDesc {
 #[serde(deny_unknown_fields)]
 pub struct MaterialDesc {
     /// Base colour, in the file's `color_space`.
-    #[serde(default = "default_color")]
+    #[serde(default = "default_color", deserialize_with = "exact::array")]
     pub color: [f32; 3],
     /// Image (PNG/JPEG, sRGB) replacing `color`, path relative to the scene file.
     pub texture: Option<String>,
     /// Emitted linear radiance (W m^-2 sr^-1), on the front side only.
+    #[serde(default, deserialize_with = "exact::optional_array")]
     pub emission: Option<[f32; 3]>,
     /// One of the seed's materials (`metal`, `plastic`, `wall`, `glass`, `wood`, `ceramic`)
     /// giving defaults for the lobe parameters below.
@@ -157,8 +163,10 @@ pub struct MaterialDesc {
     /// Conductor Fresnel for the specular lobe: a preset name (`"gold"`, `"aluminium"`, ...).
     pub conductor: Option<String>,
     /// Conductor Fresnel from a complex index of refraction: real part per RGB channel.
+    #[serde(default, deserialize_with = "exact::optional_array")]
     pub eta: Option<[f32; 3]>,
     /// Conductor Fresnel from a complex index of refraction: imaginary part per RGB channel.
+    #[serde(default, deserialize_with = "exact::optional_array")]
     pub k: Option<[f32; 3]>,
 }
 
@@ -175,10 +183,13 @@ pub struct QuadDesc {
     /// Material name.
     pub material: String,
     /// Corner at s = t = 0.
+    #[serde(deserialize_with = "exact::array")]
     pub origin: [f32; 3],
     /// First edge.
+    #[serde(deserialize_with = "exact::array")]
     pub edge_u: [f32; 3],
     /// Second edge.
+    #[serde(deserialize_with = "exact::array")]
     pub edge_v: [f32; 3],
 }
 
@@ -191,6 +202,7 @@ pub struct SphereDesc {
     /// Material name.
     pub material: String,
     /// Centre.
+    #[serde(deserialize_with = "exact::array")]
     pub center: [f32; 3],
     /// Radius.
     pub radius: f32,
@@ -208,8 +220,10 @@ pub struct CylinderDesc {
     /// Material name.
     pub material: String,
     /// Axis start (bottom).
+    #[serde(deserialize_with = "exact::array")]
     pub p0: [f32; 3],
     /// Axis end (top).
+    #[serde(deserialize_with = "exact::array")]
     pub p1: [f32; 3],
     /// Radius.
     pub radius: f32,
@@ -229,21 +243,39 @@ pub struct TransformDesc {
     /// Scale, uniform or per axis.
     pub scale: Option<ScaleDesc>,
     /// Euler angles in degrees, applied x, then y, then z.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::array")]
     pub rotate: [f32; 3],
     /// Translation.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::array")]
     pub translate: [f32; 3],
 }
 
 /// A uniform or per-axis scale.
-#[derive(Debug, Clone, Copy, Deserialize)]
-#[serde(untagged)]
+#[derive(Debug, Clone, Copy)]
 pub enum ScaleDesc {
     /// The same factor on every axis.
     Uniform(f32),
     /// One factor per axis.
     PerAxis([f32; 3]),
+}
+
+impl<'de> Deserialize<'de> for ScaleDesc {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        /// What the file may hold, before the length check.
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Raw {
+            Uniform(f32),
+            PerAxis(Vec<f32>),
+        }
+        let wanted = "scale must be a number or an array of 3 numbers";
+        match Raw::deserialize(deserializer).map_err(|_| serde::de::Error::custom(wanted))? {
+            Raw::Uniform(s) => Ok(Self::Uniform(s)),
+            Raw::PerAxis(v) => <[f32; 3]>::try_from(v)
+                .map(Self::PerAxis)
+                .map_err(|v| serde::de::Error::custom(format!("{wanted}, not {}", v.len()))),
+        }
+    }
 }
 
 /// A triangle mesh from an OBJ file.
@@ -284,11 +316,13 @@ pub struct RevolveDesc {
     /// Material name.
     pub material: String,
     /// Point on the axis where the profile's height is 0.
+    #[serde(deserialize_with = "exact::array")]
     pub base: [f32; 3],
     /// Axis direction.
-    #[serde(default = "default_up")]
+    #[serde(default = "default_up", deserialize_with = "exact::array")]
     pub axis: [f32; 3],
     /// Control points `[radius, height]`, bottom to top; a Catmull-Rom spline runs through them.
+    #[serde(deserialize_with = "exact::array_list")]
     pub profile: Vec<[f32; 2]>,
     /// Segments around the axis.
     #[serde(default = "default_segments")]

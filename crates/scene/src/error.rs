@@ -35,6 +35,16 @@ pub enum SceneError {
         /// What is wrong, naming the key and the value.
         message: String,
     },
+    /// A line of a text asset (an OBJ file) holds a value pathlight refuses.
+    #[error("{}:{line}: {message}", path.display())]
+    AssetLine {
+        /// The asset file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// What is wrong, with the value.
+        message: String,
+    },
     /// A referenced asset (mesh or texture) exists but could not be decoded.
     #[error("{path}: {message}")]
     Asset {

@@ -6,6 +6,7 @@ pub mod camera;
 pub mod default_scene;
 pub mod desc;
 pub mod error;
+mod exact;
 pub mod load;
 pub mod material;
 pub mod mesh;

@@ -10,10 +10,11 @@ use toml::Spanned;
 use crate::desc::{ColorSpace, MaterialDesc, RenderDesc, SamplerDesc, SceneDesc, Shading};
 use crate::error::SceneError;
 use crate::revolve::Revolution;
-use crate::settings::{check_max_depth, check_resolution, check_spp};
+use crate::settings::{MAX_COORDINATE, check_max_depth, check_resolution, check_spp};
 use crate::texture::srgb_to_linear;
 use crate::{
     Camera, Conductor, Lobes, Material, Object, RenderSettings, Sampler, Scene, Shape, Texture,
+    TriangleMesh,
 };
 
 /// Where a scene's text and assets come from.
@@ -159,10 +160,47 @@ impl Builder<'_, '_> {
     }
 
     fn point(&self, span: Range<usize>, key: &str, v: [f32; 3]) -> Result<Vec3, SceneError> {
-        if v.iter().all(|c| c.is_finite()) {
+        if v.iter().all(|c| c.abs() <= MAX_COORDINATE) {
             Ok(Vec3::from(v))
         } else {
-            Err(self.invalid(span, format!("{key} = {v:?} must be finite")))
+            Err(self.invalid(
+                span,
+                format!(
+                    "{key} = {v:?}: coordinates must be finite and within +-{MAX_COORDINATE:e}"
+                ),
+            ))
+        }
+    }
+
+    /// A length (a radius): finite, above zero and within the coordinate limit.
+    fn length(&self, span: Range<usize>, key: &str, value: f32) -> Result<f32, SceneError> {
+        if value > 0.0 && value <= MAX_COORDINATE {
+            Ok(value)
+        } else {
+            Err(self.invalid(
+                span,
+                format!("{key} = {value} must be > 0 and at most {MAX_COORDINATE:e}"),
+            ))
+        }
+    }
+
+    /// A mesh made from the file's values (an OBJ placed by its transform, a revolved
+    /// profile) whose vertices must all be finite and within the coordinate limit.
+    fn checked_mesh(
+        &self,
+        span: Range<usize>,
+        what: &str,
+        mesh: TriangleMesh,
+    ) -> Result<TriangleMesh, SceneError> {
+        match mesh.positions.iter().position(|p| !p.abs().cmple(Vec3::splat(MAX_COORDINATE)).all()) {
+            None => Ok(mesh),
+            Some(i) => Err(self.invalid(
+                span,
+                format!(
+                    "{what}: vertex {i} lies at {}; coordinates must be finite and within +-{MAX_COORDINATE:e}",
+                    mesh.positions[i]
+                ),
+            )),
         }
     }
 
@@ -350,6 +388,8 @@ impl Builder<'_, '_> {
         material_ids: &HashMap<String, u32>,
     ) -> Result<Vec<Object>, SceneError> {
         let mut objects = Vec::new();
+        // Where each object was declared, for errors about it.
+        let mut spans: Vec<Range<usize>> = Vec::new();
         let material = |span: Range<usize>, name: &str| {
             material_ids.get(name).copied().ok_or_else(|| {
                 let known: Vec<_> = material_ids.keys().collect();
@@ -364,6 +404,7 @@ impl Builder<'_, '_> {
         };
         for (i, q) in desc.quad.iter().enumerate() {
             let (span, d) = (q.span(), q.get_ref());
+            spans.push(span.clone());
             let edge_u = self.point(span.clone(), "edge_u", d.edge_u)?;
             let edge_v = self.point(span.clone(), "edge_v", d.edge_v)?;
             objects.push(Object {
@@ -378,24 +419,28 @@ impl Builder<'_, '_> {
         }
         for (i, s) in desc.sphere.iter().enumerate() {
             let (span, d) = (s.span(), s.get_ref());
-            if !(d.radius.is_finite() && d.radius > 0.0) {
-                return Err(self.invalid(span, format!("radius = {} must be > 0", d.radius)));
+            spans.push(span.clone());
+            let radius = self.length(span.clone(), "radius", d.radius)?;
+            if !d.texture_rotation.is_finite() {
+                return Err(self.invalid(
+                    span,
+                    format!("texture_rotation = {} must be finite", d.texture_rotation),
+                ));
             }
             objects.push(Object {
                 name: named(&d.name, "sphere", i),
                 material: material(span.clone(), &d.material)?,
                 shape: Shape::Sphere {
                     center: self.point(span, "center", d.center)?,
-                    radius: d.radius,
+                    radius,
                     texture_rotation: d.texture_rotation.to_radians(),
                 },
             });
         }
         for (i, c) in desc.cylinder.iter().enumerate() {
             let (span, d) = (c.span(), c.get_ref());
-            if !(d.radius.is_finite() && d.radius > 0.0) {
-                return Err(self.invalid(span, format!("radius = {} must be > 0", d.radius)));
-            }
+            spans.push(span.clone());
+            let radius = self.length(span.clone(), "radius", d.radius)?;
             let p0 = self.point(span.clone(), "p0", d.p0)?;
             let p1 = self.point(span.clone(), "p1", d.p1)?;
             if p0 == p1 {
@@ -407,13 +452,14 @@ impl Builder<'_, '_> {
                 shape: Shape::Cylinder {
                     p0,
                     p1,
-                    radius: d.radius,
+                    radius,
                     caps: d.caps,
                 },
             });
         }
         for (i, m) in desc.mesh.iter().enumerate() {
             let (span, d) = (m.span(), m.get_ref());
+            spans.push(span.clone());
             let material = material(span.clone(), &d.material)?;
             let path = self.source.base_dir.join(&d.file);
             if !path.is_file() {
@@ -425,6 +471,8 @@ impl Builder<'_, '_> {
             let mut mesh = crate::mesh::load_obj(&path)?;
             mesh.transform(d.transform.to_matrix());
             mesh.flat = d.shading == Shading::Flat;
+            let what = format!("file = {:?} placed by its transform", d.file);
+            let mesh = self.checked_mesh(span, &what, mesh)?;
             objects.push(Object {
                 name: named(&d.name, "mesh", i),
                 material,
@@ -433,12 +481,17 @@ impl Builder<'_, '_> {
         }
         for (i, r) in desc.revolve.iter().enumerate() {
             let (span, d) = (r.span(), r.get_ref());
+            spans.push(span.clone());
             let material = material(span.clone(), &d.material)?;
             let axis = self.point(span.clone(), "axis", d.axis)?;
-            if d.profile.len() < 2 || d.profile.iter().flatten().any(|v| !v.is_finite()) {
+            let in_range = |v: &f32| v.abs() <= MAX_COORDINATE;
+            if d.profile.len() < 2 || !d.profile.iter().flatten().all(in_range) {
                 return Err(self.invalid(
                     span,
-                    "profile needs at least two finite [radius, height] points".into(),
+                    format!(
+                        "profile needs at least two [radius, height] points, finite and within \
+                         +-{MAX_COORDINATE:e}"
+                    ),
                 ));
             }
             if !(3..=4096).contains(&d.segments) || !(1..=4096).contains(&d.rings) {
@@ -454,18 +507,34 @@ impl Builder<'_, '_> {
                 return Err(self.invalid(span, "axis must not be zero".into()));
             }
             let revolution = Revolution {
-                base: self.point(span, "base", d.base)?,
+                base: self.point(span.clone(), "base", d.base)?,
                 axis: axis.normalize(),
                 profile: d.profile.iter().map(|&p| Vec2::from(p)).collect(),
                 segments: d.segments,
                 rings: d.rings,
                 cap_bottom: d.cap_bottom,
             };
+            let mesh = self.checked_mesh(span, "the revolved profile", revolution.to_mesh())?;
             objects.push(Object {
                 name: named(&d.name, "revolve", i),
                 material,
-                shape: Shape::Mesh(revolution.to_mesh()),
+                shape: Shape::Mesh(mesh),
             });
+        }
+        // Names pick objects out (the viewer's messages, `bench --without`): each must be one.
+        let mut seen: HashMap<&str, usize> = HashMap::new();
+        for (i, object) in objects.iter().enumerate() {
+            if let Some(&first) = seen.get(object.name.as_str()) {
+                let first_line = line_column(self.source.text, spans[first].start).0;
+                return Err(self.invalid(
+                    spans[i].clone(),
+                    format!(
+                        "name = {:?} is already the name of the object on line {first_line}",
+                        object.name
+                    ),
+                ));
+            }
+            seen.insert(&object.name, i);
         }
         Ok(objects)
     }

@@ -22,8 +22,34 @@ impl TransformDesc {
     }
 }
 
+/// Refuses a vertex position, normal or texture coordinate of the OBJ text `text` that is
+/// not a finite number (`1e300` overflows f32: infinite), naming its line.
+fn check_obj_numbers(path: &Path, text: &str) -> Result<(), SceneError> {
+    for (index, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let what = match words.next() {
+            Some("v") => "vertex position",
+            Some("vn") => "vertex normal",
+            Some("vt") => "texture coordinate",
+            _ => continue,
+        };
+        // Malformed numbers are left to the OBJ parser, which reports them.
+        if words.any(|w| w.parse::<f32>().is_ok_and(|v| !v.is_finite())) {
+            return Err(SceneError::AssetLine {
+                path: path.to_owned(),
+                line: index + 1,
+                message: format!("{what} {:?} is not a finite number", line.trim()),
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Reads an OBJ file (all its models, triangulated) into one mesh in object space.
 pub fn load_obj(path: &Path) -> Result<TriangleMesh, SceneError> {
+    if let Ok(bytes) = std::fs::read(path) {
+        check_obj_numbers(path, &String::from_utf8_lossy(&bytes))?;
+    }
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,

@@ -2,6 +2,9 @@
 
 use crate::error::RangeError;
 
+/// Largest magnitude of a coordinate or a length in a scene: far below f32's range, so that
+/// boxes, areas and distances computed from the scene stay finite.
+pub const MAX_COORDINATE: f32 = 1e15;
 /// Largest accepted image side, in pixels.
 pub const MAX_RESOLUTION: u32 = 8192;
 /// Largest accepted samples per pixel for one render.

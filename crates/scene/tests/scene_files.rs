@@ -218,3 +218,98 @@ fn colours_are_srgb_unless_the_file_says_linear() {
     .unwrap();
     assert_eq!(linear.materials[0].base_color.x, 0.5);
 }
+
+/// Geometry whose boxes or areas would not be finite never reaches the BVH build (where it
+/// panicked inside obvhs): non-finite or overflowing values in a transform, a revolve
+/// profile, an OBJ file or a radius are refused with the file and line.
+#[test]
+fn non_finite_and_overflowing_geometry_is_refused_with_its_line() {
+    let mesh = |file: &str, transform: &str| {
+        format!("[materials.m]\n[[mesh]]\nmaterial = \"m\"\nfile = \"{file}\"\n{transform}")
+    };
+    for translate in ["nan", "inf", "-inf", "1e20"] {
+        let message = error(&mesh(
+            "tetra.obj",
+            &format!("transform = {{ translate = [{translate}, 0, 0] }}\n"),
+        ));
+        assert!(
+            message.starts_with("test.toml:7:") && message.contains("vertex 0"),
+            "{translate}: {message}"
+        );
+    }
+    let message = error(&mesh("overflowing.obj", ""));
+    assert!(
+        message.contains("overflowing.obj:3:") && message.contains("not a finite number"),
+        "{message}"
+    );
+    let message = error(&mesh("nan-vertex.obj", ""));
+    assert!(message.contains("nan-vertex.obj:3:"), "{message}");
+    // Finite in the file, overflowing once revolved.
+    let message = error(
+        "[materials.m]\n[[revolve]]\nmaterial = \"m\"\nbase = [0, 0, 0]\n\
+         profile = [[1e38, 0], [1e38, 1]]\n",
+    );
+    assert!(
+        message.starts_with("test.toml:7:") && message.contains("profile"),
+        "{message}"
+    );
+    let message = error(
+        "[materials.m]\n[[revolve]]\nmaterial = \"m\"\naxis = [1e38, 1e38, 0]\nbase = [0, 0, 0]\nprofile = [[1, 0], [1, 1]]\n",
+    );
+    assert!(message.contains("axis"), "{message}");
+    for radius in ["3e38", "inf", "nan", "0", "-1"] {
+        let message = error(&format!(
+            "[materials.m]\n[[sphere]]\nmaterial = \"m\"\ncenter = [0, 0, 0]\nradius = {radius}\n"
+        ));
+        assert!(
+            message.starts_with("test.toml:7:") && message.contains("radius"),
+            "{radius}: {message}"
+        );
+    }
+}
+
+/// Values that were silently accepted: an array with more elements than the key takes (the
+/// rest was dropped), a non-finite texture rotation, two objects of one name.
+#[test]
+fn extra_elements_bad_rotations_and_duplicate_names_are_refused() {
+    let sphere = |extra: &str| {
+        format!(
+            "[materials.m]\n[[sphere]]\nmaterial = \"m\"\ncenter = [0, 0, 0]\nradius = 1\n{extra}"
+        )
+    };
+    let message = error("[materials.m]\ncolor = [0.5, 0.5, 0.5, 0.5]\n");
+    assert!(
+        message.contains("invalid length 4") && message.starts_with("test.toml:7:"),
+        "{message}"
+    );
+    let message =
+        error("[materials.m]\n[[revolve]]\nmaterial = \"m\"\nprofile = [[1, 0, 9], [1, 1]]\n");
+    assert!(message.contains("invalid length 3"), "{message}");
+    let message = error(
+        "[materials.m]\n[[mesh]]\nmaterial = \"m\"\nfile = \"tetra.obj\"\ntransform = { scale = [1, 1, 1, 1] }\n",
+    );
+    assert!(message.contains("scale"), "{message}");
+    let text = CAMERA.replace("[32, 32]", "[32, 32, 7]");
+    let source = SceneSource {
+        name: "r.toml".into(),
+        text: &text,
+        base_dir: data(),
+        embedded: &[],
+    };
+    let message = load_scene(&source).unwrap_err().to_string();
+    assert!(message.contains("invalid length 3"), "{message}");
+    for rotation in ["nan", "inf"] {
+        let message = error(&sphere(&format!("texture_rotation = {rotation}\n")));
+        assert!(
+            message.contains("texture_rotation"),
+            "{rotation}: {message}"
+        );
+    }
+    let twice = "[materials.m]\n[[sphere]]\nname = \"ball\"\nmaterial = \"m\"\ncenter = [0, 0, 0]\nradius = 1\n\
+                 [[quad]]\nname = \"ball\"\nmaterial = \"m\"\norigin = [0, 0, 0]\nedge_u = [1, 0, 0]\nedge_v = [0, 1, 0]\n";
+    let message = error(twice);
+    assert!(
+        message.contains("\"ball\"") && message.contains("line"),
+        "{message}"
+    );
+}

@@ -82,7 +82,7 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
              `pathlight render [SCENE] -o image.png`"
         )
     })?;
-    let mut viewer = Viewer::new(scene, args);
+    let mut viewer = Viewer::new(scene, args)?;
     event_loop
         .run_app(&mut viewer)
         .context("the window system failed")?;
@@ -109,9 +109,9 @@ struct Viewer {
 }
 
 impl Viewer {
-    fn new(scene: Scene, args: &ViewArgs) -> Self {
-        Self {
-            prepared: PreparedScene::new(&scene),
+    fn new(scene: Scene, args: &ViewArgs) -> anyhow::Result<Self> {
+        Ok(Self {
+            prepared: PreparedScene::new(&scene)?,
             orbit: Orbit::from_camera(&scene.camera),
             lights: LightSwitch::new(&scene, args.light_strength),
             iterations: Iterations::new(args.frames_per_iter, args.iters),
@@ -124,7 +124,7 @@ impl Viewer {
             rays: RayRate::new(),
             window: None,
             error: None,
-        }
+        })
     }
 
     /// Ends the event loop with `err` as the command's error.

@@ -109,7 +109,7 @@ mod tests {
     #[test]
     fn picks_the_nearest_object_under_the_point() {
         let scene = default_scene::load().unwrap();
-        let prepared = PreparedScene::new(&scene);
+        let prepared = PreparedScene::new(&scene).unwrap();
         for (name, centre) in [
             ("gold sphere", Vec3::new(0.2, 0.6, -2.4)),
             ("earth", Vec3::new(-1.2, 0.5, -2.05)),
@@ -148,7 +148,7 @@ mod tests {
             lit.lobes,
             own.materials[own.objects[vase].material as usize].lobes
         );
-        let prepared = PreparedScene::new(&own);
+        let prepared = PreparedScene::new(&own).unwrap();
         let lights = |s: &Scene| prepared.shading_of(s).light_count;
         assert!(lights(&scene) > lights(&own));
         assert!(

@@ -32,7 +32,7 @@ pub fn scene(relative: &str, size: u32, spp: u32, seed: u32) -> Scene {
 
 /// A GPU renderer of `scene` (prepared here) finding hits with the BVH.
 pub fn gpu_renderer(scene: &Scene) -> GpuRenderer {
-    let prepared = PreparedScene::new(scene);
+    let prepared = PreparedScene::new(scene).unwrap();
     GpuRenderer::new(
         context(),
         &prepared,
@@ -58,7 +58,7 @@ pub fn render(scene: &Scene) -> Film {
 
 /// Renders `scene` to its full spp on the CPU backend.
 pub fn render_cpu(scene: &Scene) -> Film {
-    let prepared = PreparedScene::new(scene);
+    let prepared = PreparedScene::new(scene).unwrap();
     let mut renderer = pathlight_cpu::CpuRenderer::new(&prepared, &scene.camera, &scene.settings);
     render_to(&mut renderer, scene.settings.spp)
 }

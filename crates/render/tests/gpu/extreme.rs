@@ -99,7 +99,7 @@ fn extreme_values_give_finite_samples_on_both_backends() {
     // The camera looks along the floor plane: y = 0 exactly.
     s.camera.position.y = 0.0;
     s.camera.look_at.y = 0.0;
-    let prepared = PreparedScene::new(&s);
+    let prepared = PreparedScene::new(&s).unwrap();
     let params = GpuRenderParams::new(&s.camera, &s.settings, &prepared.shading);
     let cpu_scene = CpuScene::new(&prepared);
     let mut tracer = Tracer::new(&cpu_scene);

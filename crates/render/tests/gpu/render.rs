@@ -242,7 +242,7 @@ fn frames_in_bands_and_scene_changes_keep_the_image_exact() {
     glow.emission = Vec3::new(4.0, 3.0, 2.0);
     lit.materials.push(glow);
     lit.objects[sphere].material = lit.materials.len() as u32 - 1;
-    let shading = PreparedScene::new(&s).shading_of(&lit);
+    let shading = PreparedScene::new(&s).unwrap().shading_of(&lit);
     assert!(shading.light_count > 1);
     r.set_materials(&shading).unwrap();
     assert_eq!(render_to(&mut r, 2), render(&lit));

@@ -169,7 +169,8 @@ fn trace_chunk(
 fn no_ray_passes_between_the_triangles_of_a_closed_mesh() {
     let mut total = 0;
     for (seed, (name, mesh)) in watertight_meshes().into_iter().enumerate() {
-        let prepared = PreparedScene::new(&scene_of(vec![object(name, Shape::Mesh(mesh.clone()))]));
+        let prepared =
+            PreparedScene::new(&scene_of(vec![object(name, Shape::Mesh(mesh.clone()))])).unwrap();
         let mut rng = StdRng::seed_from_u64(100 + seed as u64);
         let aimed = rays_at_shared_edges(&mut rng, &mesh, 3_400_000);
         let rays: Vec<TraceRay> = aimed
@@ -235,7 +236,7 @@ fn room_rays(seed: u64, count: usize) -> Vec<TraceRay> {
 /// Every acceleration scheme finds what the CPU twin finds.
 #[test]
 fn wgsl_traversal_matches_cpu_twin() {
-    let prepared = PreparedScene::new(&default_scene::load().unwrap());
+    let prepared = PreparedScene::new(&default_scene::load().unwrap()).unwrap();
     let rays = room_rays(5, 20_000);
     for accel in Accel::ALL {
         check_hits(
@@ -289,7 +290,7 @@ fn wgsl_traversal_matches_cpu_twin_in_mixed_leaves() {
         material,
         shape: Shape::Mesh(cloud),
     });
-    let prepared = PreparedScene::new(&scene);
+    let prepared = PreparedScene::new(&scene).unwrap();
     let g = &prepared.geometry;
     let mixed = g
         .nodes
@@ -330,7 +331,7 @@ fn a_scene_without_primitives_hits_nothing() {
         material,
         shape: Shape::Mesh(TriangleMesh::default()),
     }];
-    let prepared = PreparedScene::new(&scene);
+    let prepared = PreparedScene::new(&scene).unwrap();
     assert!(prepared.geometry.primitives.is_empty());
     // The GPU's placeholder: four unused children (inverted boxes), so that no ray enters
     // it and loops (an empty box at the origin would be entered by rays through the origin).
@@ -463,7 +464,7 @@ fn traversal_stack_bound_holds_the_deepest_walk() {
         embedded: &[],
     })
     .unwrap();
-    let prepared = PreparedScene::new(&scene);
+    let prepared = PreparedScene::new(&scene).unwrap();
     let rays: Vec<TraceRay> = lines
         .iter()
         .map(|&(x, y)| TraceRay {
