@@ -63,6 +63,13 @@ fn render_to_file(scene: &Scene, args: &RenderArgs) -> anyhow::Result<()> {
     progress.finish();
     let render_time = render_started.elapsed();
     let film = renderer.film()?;
+    let dropped = renderer.samples_dropped()?;
+    if dropped > 0 {
+        note!(
+            "warning: {dropped} samples were not finite (NaN or infinite) and count as black; \
+             this is a bug in pathlight, please report it with the scene"
+        );
+    }
     if film.spp == 0 {
         anyhow::bail!("interrupted before the first sample; nothing written");
     }

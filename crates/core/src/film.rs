@@ -29,8 +29,7 @@ impl Film {
     }
 
     /// The mean of the GPU's fixed-point sums ([`GpuAccumPixel`]) of `spp` samples per
-    /// pixel, where rows `0 .. rows_ahead` (a frame in progress) hold one sample more. A
-    /// sum too large for f32 reads as 0.
+    /// pixel, where rows `0 .. rows_ahead` (a frame in progress) hold one sample more.
     pub fn from_fixed_point(
         width: u32,
         height: u32,
@@ -44,10 +43,7 @@ impl Film {
             .map(|(i, a)| {
                 let ahead = (i / width as usize) < rows_ahead as usize;
                 let scale = 1.0 / f64::from((spp + u32::from(ahead)).max(1));
-                [0, 1, 2].map(|c| {
-                    let v = (a.channel_sum(c) * scale) as f32;
-                    if v.is_finite() { v } else { 0.0 }
-                })
+                [0, 1, 2].map(|c| (a.channel_sum(c) * scale) as f32)
             })
             .collect();
         Self {

@@ -52,6 +52,11 @@ pub trait Renderer {
     /// Rays traced (camera, extension and shadow rays) since the start or the last restart.
     fn rays_traced(&self) -> Result<u64, RenderError>;
 
+    /// Samples since the start or the last restart whose radiance was not finite (NaN or
+    /// infinite): they count as black, so that no NaN reaches the image, and a correct render
+    /// has none. Tests require zero; `pathlight render` warns otherwise.
+    fn samples_dropped(&self) -> Result<u64, RenderError>;
+
     /// The mean of the samples so far.
     fn film(&self) -> Result<Film, RenderError>;
 

@@ -27,7 +27,7 @@ use rayon::prelude::*;
 pub use crate::bvh::Tracer;
 pub use crate::cpu_scene::CpuScene;
 pub use crate::row::InstructionSet;
-use crate::row::{RowJob, render_row_with};
+use crate::row::{RowJob, Tally, render_row_with};
 
 /// Aimed-for duration of one `advance` (for progress reports and interruption).
 const TARGET_BATCH: Duration = Duration::from_millis(250);
@@ -41,8 +41,8 @@ pub struct CpuRenderer {
     sums: Vec<[f64; 3]>,
     samples_done: u32,
     batch_samples: u32,
-    /// Rays traced so far.
-    rays_traced: u64,
+    /// Rays traced and samples dropped as not finite, since the last restart.
+    tally: Tally,
     /// The compiled form of the path tracer that runs.
     isa: InstructionSet,
 }
@@ -72,7 +72,7 @@ impl CpuRenderer {
             sums: vec![[0.0; 3]; pixels],
             samples_done: 0,
             batch_samples: 1,
-            rays_traced: 0,
+            tally: Tally::default(),
             isa: InstructionSet::best(),
         }
     }
@@ -90,13 +90,13 @@ impl CpuRenderer {
         Ok(())
     }
 
-    /// Adds `samples` samples per pixel (from sample `samples_done`) to every pixel; returns
-    /// the rays traced.
-    fn render(&mut self, samples: u32) -> u64 {
+    /// Adds `samples` samples per pixel (from sample `samples_done`) to every pixel.
+    fn render(&mut self, samples: u32) {
         let scene = CpuScene::new(&self.scene);
         let (params, isa, offset) = (&self.params, self.isa, self.samples_done);
         let width = params.width as usize;
-        self.sums
+        let tally = self
+            .sums
             .par_chunks_mut(width)
             .enumerate()
             .map_init(
@@ -111,7 +111,9 @@ impl CpuRenderer {
                     render_row_with(isa, tracer, &job, row)
                 },
             )
-            .sum()
+            .sum::<Tally>();
+        self.tally = self.tally + tally;
+        self.samples_done += samples;
     }
 }
 
@@ -141,7 +143,7 @@ impl Renderer for CpuRenderer {
     fn restart(&mut self) {
         self.sums.fill([0.0; 3]);
         self.samples_done = 0;
-        self.rays_traced = 0;
+        self.tally = Tally::default();
     }
 
     /// Twin of the GPU renderer's `advance`: the same samples of the same pixels give the
@@ -152,8 +154,7 @@ impl Renderer for CpuRenderer {
             return Ok(0);
         }
         let started = Instant::now();
-        self.rays_traced += self.render(samples);
-        self.samples_done += samples;
+        self.render(samples);
         let per_sample = started.elapsed().as_secs_f64() / f64::from(samples);
         self.batch_samples =
             ((TARGET_BATCH.as_secs_f64() / per_sample.max(1e-9)) as u32).clamp(1, 1024);
@@ -167,8 +168,7 @@ impl Renderer for CpuRenderer {
     }
 
     fn queue_frame(&mut self) -> Result<(), RenderError> {
-        self.rays_traced += self.render(1);
-        self.samples_done += 1;
+        self.render(1);
         Ok(())
     }
 
@@ -181,7 +181,11 @@ impl Renderer for CpuRenderer {
     }
 
     fn rays_traced(&self) -> Result<u64, RenderError> {
-        Ok(self.rays_traced)
+        Ok(self.tally.rays)
+    }
+
+    fn samples_dropped(&self) -> Result<u64, RenderError> {
+        Ok(self.tally.dropped)
     }
 
     fn film(&self) -> Result<Film, RenderError> {

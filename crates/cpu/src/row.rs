@@ -22,19 +22,43 @@ pub(crate) struct RowJob<'a> {
     pub samples: Range<u32>,
 }
 
-/// Adds the samples of `job` to its row's sums; returns the rays traced. The row's samples
+/// What rendering some samples did: the rays traced (camera, extension and shadow rays) and
+/// the samples dropped because their radiance was not finite.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(crate) struct Tally {
+    pub rays: u64,
+    pub dropped: u64,
+}
+
+impl std::ops::Add for Tally {
+    type Output = Self;
+    fn add(self, other: Self) -> Self {
+        Self {
+            rays: self.rays + other.rays,
+            dropped: self.dropped + other.dropped,
+        }
+    }
+}
+
+impl std::iter::Sum for Tally {
+    fn sum<I: Iterator<Item = Self>>(iter: I) -> Self {
+        iter.fold(Self::default(), |a, b| a + b)
+    }
+}
+
+/// Adds the samples of `job` to its row's sums; returns what it did. The row's samples
 /// (pixel by pixel, each pixel's in turn) are traced as paths side by side, [`PACKET`] at a
 /// time, their rays traced together as packets; a path that ends hands its lane to the next
 /// sample. The whole path tracer is inlined here, so that each [`InstructionSet`] level
 /// compiles all of it.
 #[inline(always)]
-fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
+fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> Tally {
     let (scene, params) = (job.scene, job.params);
     let samples_per_pixel = job.samples.len();
     let sample_count = row.len() * samples_per_pixel;
     let mut next_sample = 0;
     let mut lanes: [Option<(usize, Path)>; PACKET] = std::array::from_fn(|_| None);
-    let mut rays = 0;
+    let mut tally = Tally::default();
     // Reused from round to round: only the lanes in use are written.
     let mut packet = RayPacket {
         t_max: [T_MAX; PACKET],
@@ -54,7 +78,7 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
                 if path.alive {
                     *lane = Some((x, path));
                 } else {
-                    rays += finish(&path, &mut row[x]);
+                    tally = tally + finish(&path, &mut row[x]);
                 }
             }
             if let Some((_, path)) = lane {
@@ -63,7 +87,7 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
             }
         }
         if packet.active == 0 {
-            return rays;
+            return tally;
         }
         let hits = tracer.intersect_packet(&packet);
         shadows.active = 0;
@@ -85,21 +109,25 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
                 path.add_unblocked(unblocked[l]);
             }
             if !path.alive {
-                rays += finish(path, &mut row[*x]);
+                tally = tally + finish(path, &mut row[*x]);
                 *lane = None;
             }
         }
     }
 }
 
-/// Adds the sample of the ended `path` to its pixel's `sum`; returns its rays.
+/// Adds the sample of the ended `path` to its pixel's `sum` (a non-finite one as zero);
+/// returns its rays and whether it was dropped.
 #[inline(always)]
-fn finish(path: &Path, sum: &mut [f64; 3]) -> u64 {
+fn finish(path: &Path, sum: &mut [f64; 3]) -> Tally {
     let value = accumulated_value(path.sample.radiance);
     for c in 0..3 {
         sum[c] += f64::from(value[c]);
     }
-    u64::from(path.sample.rays)
+    Tally {
+        rays: u64::from(path.sample.rays),
+        dropped: u64::from(!path.sample.radiance.is_finite()),
+    }
 }
 
 /// The instruction set a row renderer is compiled for: `render_row` is compiled once per
@@ -166,7 +194,7 @@ pub(crate) fn render_row_with(
     tracer: &mut Tracer,
     job: &RowJob,
     row: &mut [[f64; 3]],
-) -> u64 {
+) -> Tally {
     match isa {
         InstructionSet::Baseline => render_row(tracer, job, row),
         // SAFETY: `InstructionSet::supported` found the features on this CPU.
@@ -181,7 +209,7 @@ pub(crate) fn render_row_with(
 /// [`render_row`] for x86-64-v3.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe")]
-fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
+fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> Tally {
     render_row(tracer, job, row)
 }
 
@@ -190,6 +218,6 @@ fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]])
 #[target_feature(
     enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe,avx512f,avx512vl,avx512bw,avx512dq,avx512cd,gfni"
 )]
-fn render_row_x86_64_v4_gfni(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> u64 {
+fn render_row_x86_64_v4_gfni(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> Tally {
     render_row(tracer, job, row)
 }

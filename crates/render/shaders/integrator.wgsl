@@ -49,13 +49,17 @@ fn add_fixed(acc: ptr<function, AccumPixel>, x: AccumPixel) {
 }
 
 @group(1) @binding(1) var<storage, read_write> accum: array<AccumPixel>;
-// Rays traced since the counter was cleared, as a 64-bit count: [low word, high word].
-@group(1) @binding(2) var<storage, read_write> ray_counter: array<atomic<u32>, 2>;
+// Since the counters were cleared: rays traced, as a 64-bit count [low word, high word], and
+// samples dropped because their radiance was not finite (none in a correct render).
+@group(1) @binding(2) var<storage, read_write> counters: array<atomic<u32>, 3>;
 
 // Rays this invocation traced (camera, extension and shadow rays).
 var<private> rays_traced: u32;
-// Rays this workgroup traced, added to `ray_counter` once per workgroup.
+// Non-finite samples this invocation dropped.
+var<private> samples_dropped: u32;
+// Rays this workgroup traced and samples it dropped, added to `counters` once per workgroup.
 var<workgroup> workgroup_rays: atomic<u32>;
+var<workgroup> workgroup_dropped: atomic<u32>;
 
 const T_MAX: f32 = 1.0e30;
 
@@ -211,6 +215,8 @@ fn render(@builtin(global_invocation_id) gid: vec3u, @builtin(local_invocation_i
             let radiance = trace_path(camera_ray(x, y, &sampler), &sampler);
             if is_finite3(radiance) {
                 add_sample(&batch, radiance);
+            } else {
+                samples_dropped++;
             }
         }
         var total = accum[pixel];
@@ -218,12 +224,14 @@ fn render(@builtin(global_invocation_id) gid: vec3u, @builtin(local_invocation_i
         accum[pixel] = total;
     }
     atomicAdd(&workgroup_rays, rays_traced);
+    atomicAdd(&workgroup_dropped, samples_dropped);
     workgroupBarrier();
     if local == 0u {
         let n = atomicLoad(&workgroup_rays);
-        let old = atomicAdd(&ray_counter[0], n);
+        let old = atomicAdd(&counters[0], n);
         if old > 0xffffffffu - n {
-            atomicAdd(&ray_counter[1], 1u);
+            atomicAdd(&counters[1], 1u);
         }
+        atomicAdd(&counters[2], atomicLoad(&workgroup_dropped));
     }
 }

@@ -69,8 +69,9 @@ pub struct GpuRenderer {
     pipeline: wgpu::ComputePipeline,
     params_buffer: wgpu::Buffer,
     accum_buffer: wgpu::Buffer,
-    /// Rays traced since the last restart (64-bit: low word, high word).
-    ray_counter: wgpu::Buffer,
+    /// Since the last restart: rays traced (64-bit: low word, high word) and samples
+    /// dropped as not finite (`counters` in `integrator.wgsl`).
+    counters: wgpu::Buffer,
     frame_layout: wgpu::BindGroupLayout,
     frame_bind_group: wgpu::BindGroup,
     params: GpuRenderParams,
@@ -136,9 +137,9 @@ impl GpuRenderer {
             mapped_at_creation: false,
         });
         let accum_buffer = create_accumulation(device, accum_size);
-        let ray_counter = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("ray counter"),
-            size: size_of::<u64>() as u64,
+        let counters = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("counters"),
+            size: 3 * size_of::<u32>() as u64,
             usage: wgpu::BufferUsages::STORAGE
                 | wgpu::BufferUsages::COPY_SRC
                 | wgpu::BufferUsages::COPY_DST,
@@ -149,7 +150,7 @@ impl GpuRenderer {
             &frame_layout,
             &params_buffer,
             &accum_buffer,
-            &ray_counter,
+            &counters,
         );
         Ok(Self {
             ctx: ctx.clone(),
@@ -157,7 +158,7 @@ impl GpuRenderer {
             pipeline,
             params_buffer,
             accum_buffer,
-            ray_counter,
+            counters,
             frame_layout,
             frame_bind_group,
             rows_ahead: 0,
@@ -307,7 +308,7 @@ impl Renderer for GpuRenderer {
                 &self.frame_layout,
                 &self.params_buffer,
                 &self.accum_buffer,
-                &self.ray_counter,
+                &self.counters,
             );
             self.rows_per_dispatch = camera.height.min(WORKGROUP * 4);
             self.batch_samples = 1;
@@ -327,7 +328,7 @@ impl Renderer for GpuRenderer {
     fn restart(&mut self) {
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         encoder.clear_buffer(&self.accum_buffer, 0, None);
-        encoder.clear_buffer(&self.ray_counter, 0, None);
+        encoder.clear_buffer(&self.counters, 0, None);
         self.ctx.queue.submit([encoder.finish()]);
         self.samples_done = 0;
         self.rows_ahead = 0;
@@ -394,8 +395,13 @@ impl Renderer for GpuRenderer {
     }
 
     fn rays_traced(&self) -> Result<u64, RenderError> {
-        let words: Vec<u32> = self.read_buffer(&self.ray_counter)?;
+        let words: Vec<u32> = self.read_buffer(&self.counters)?;
         Ok(u64::from(words[0]) | (u64::from(words[1]) << 32))
+    }
+
+    fn samples_dropped(&self) -> Result<u64, RenderError> {
+        let words: Vec<u32> = self.read_buffer(&self.counters)?;
+        Ok(u64::from(words[2]))
     }
 
     /// Copies the accumulation back and divides by each pixel's sample count. `spp` of the
@@ -452,9 +458,9 @@ fn frame_bind_group(
     layout: &wgpu::BindGroupLayout,
     params: &wgpu::Buffer,
     accum: &wgpu::Buffer,
-    ray_counter: &wgpu::Buffer,
+    counters: &wgpu::Buffer,
 ) -> wgpu::BindGroup {
-    bind_buffers(device, "frame", layout, &[params, accum, ray_counter])
+    bind_buffers(device, "frame", layout, &[params, accum, counters])
 }
 
 /// The integrator pipeline with the given scheme and traversal stack.

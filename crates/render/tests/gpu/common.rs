@@ -43,12 +43,21 @@ pub fn gpu_renderer(scene: &Scene) -> GpuRenderer {
     .unwrap()
 }
 
-/// Renders with `renderer` to `spp` samples per pixel.
+/// Renders with `renderer` to `spp` samples per pixel; every sample must have been finite.
 pub fn render_to(renderer: &mut dyn Renderer, spp: u32) -> Film {
+    let (film, dropped) = render_counting_dropped(renderer, spp);
+    assert_eq!(dropped, 0, "{dropped} samples were not finite");
+    film
+}
+
+/// Renders with `renderer` to `spp` samples per pixel; returns the image and the number of
+/// samples dropped as not finite.
+pub fn render_counting_dropped(renderer: &mut dyn Renderer, spp: u32) -> (Film, u64) {
     while renderer.samples_done() < spp {
         renderer.advance(spp - renderer.samples_done()).unwrap();
     }
-    renderer.film().unwrap()
+    let dropped = renderer.samples_dropped().unwrap();
+    (renderer.film().unwrap(), dropped)
 }
 
 /// Renders `scene` to its full spp on the GPU.

@@ -11,7 +11,7 @@ use pathlight_cpu::sampler::Sampler;
 use pathlight_cpu::{CpuScene, Tracer};
 use pathlight_scene::{SceneSource, load_scene};
 
-use crate::common::{render, render_cpu};
+use crate::common::{gpu_renderer, render, render_counting_dropped, render_cpu};
 
 const SCENE: &str = r#"
 color_space = "linear"
@@ -129,6 +129,42 @@ fn extreme_values_give_finite_samples_on_both_backends() {
         assert!(
             (g[i] - c[i]).abs() <= 0.01 * c[i],
             "GPU mean {g:?}, CPU mean {c:?}"
+        );
+    }
+}
+
+/// A sample that is not finite is dropped, not hidden: a scene whose light emits NaN (no
+/// file can say so; a program can) makes both backends count every sample that saw it, and
+/// the image stays finite.
+#[test]
+fn non_finite_samples_are_counted_on_both_backends() {
+    let mut s = load_scene(&SceneSource {
+        name: "extreme".into(),
+        text: SCENE,
+        base_dir: ".".into(),
+        embedded: &[],
+    })
+    .unwrap();
+    s.camera.width = 16;
+    s.camera.height = 16;
+    s.settings.spp = 2;
+    for m in &mut s.materials {
+        if m.emission.max_element() > 0.0 {
+            m.emission.x = f32::NAN;
+        }
+    }
+    let prepared = PreparedScene::new(&s).unwrap();
+    let mut cpu = pathlight_cpu::CpuRenderer::new(&prepared, &s.camera, &s.settings);
+    let (cpu_film, cpu_dropped) = render_counting_dropped(&mut cpu, 2);
+    let (gpu_film, gpu_dropped) = render_counting_dropped(&mut gpu_renderer(&s), 2);
+    for (name, film, dropped) in [
+        ("CPU", cpu_film, cpu_dropped),
+        ("GPU", gpu_film, gpu_dropped),
+    ] {
+        assert!(dropped > 10, "{name}: {dropped} of 512 samples counted");
+        assert!(
+            film.pixels.iter().flatten().all(|c| c.is_finite()),
+            "{name}"
         );
     }
 }
