@@ -134,7 +134,7 @@ pub struct BenchArgs {
     pub warmup: u32,
     /// Stop the warm-up, and the timed frames, after this many seconds each (at least one
     /// frame is always timed), so slow adapters finish.
-    #[arg(long, default_value = "20s", value_name = "DURATION", value_parser = duration)]
+    #[arg(long, default_value = "20s", value_name = "DURATION", value_parser = duration, allow_negative_numbers = true)]
     pub time_limit: Duration,
     /// How the nearest hit is found (GPU backend).
     #[arg(long, value_enum, default_value_t = AccelArg::Bvh)]

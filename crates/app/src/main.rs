@@ -28,6 +28,10 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // The render has said what it kept.
+        Err(err) if err.is::<render::Interrupted>() => {
+            ExitCode::from(render::Interrupted::EXIT_CODE)
+        }
         Err(err) => {
             note!("error: {err:#}");
             ExitCode::FAILURE

@@ -15,6 +15,19 @@ use crate::cli::RenderArgs;
 use crate::output;
 use crate::progress::Progress;
 
+/// The error of a render stopped by SIGINT or SIGTERM: the image with the samples rendered
+/// so far has been written (or nothing, before the first sample). The process exits with
+/// [`Interrupted::EXIT_CODE`], so that scripts can tell it from a finished render.
+#[derive(Debug, thiserror::Error)]
+#[error("interrupted")]
+pub struct Interrupted;
+
+impl Interrupted {
+    /// The exit status of an interrupted render (as a shell reports a command stopped by
+    /// SIGINT).
+    pub const EXIT_CODE: u8 = 130;
+}
+
 /// Runs the command.
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if args.list_adapters {
@@ -23,20 +36,26 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         }
         return Ok(());
     }
+    // Ctrl-C (SIGINT) and SIGTERM (kill, timeout, systemd, job schedulers) stop the render
+    // between batches, from the start: a signal during set-up must not kill the process.
+    let interrupted = Arc::new(AtomicBool::new(false));
+    let flag = interrupted.clone();
+    // A second handler cannot be installed (e.g. in tests); rendering works without one.
+    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
     let mut scene = load_scene(&args.scene)?;
     if let Some(spp) = args.spp {
         scene.settings.spp = spp;
     }
     check_spp(scene.settings.spp)?;
-    let created = output::check_writable(&args.output)?;
-    let result = render_to_file(&scene, args);
-    if result.is_err() && created {
-        let _ = std::fs::remove_file(&args.output);
-    }
-    result
+    output::check_writable(&args.output)?;
+    render_to_file(&scene, args, &interrupted)
 }
 
-fn render_to_file(scene: &Scene, args: &RenderArgs) -> anyhow::Result<()> {
+fn render_to_file(
+    scene: &Scene,
+    args: &RenderArgs,
+    interrupted: &AtomicBool,
+) -> anyhow::Result<()> {
     let started = Instant::now();
     let prepared = PreparedScene::new(scene)?;
     let device = Device::open(&args.device)?;
@@ -46,11 +65,6 @@ fn render_to_file(scene: &Scene, args: &RenderArgs) -> anyhow::Result<()> {
         Device::Cpu => "backend",
     };
     note!("{kind}: {}", renderer.device());
-
-    let interrupted = Arc::new(AtomicBool::new(false));
-    let flag = interrupted.clone();
-    // A second handler cannot be installed (e.g. in tests); rendering works without one.
-    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
 
     let total = scene.settings.spp;
     let (width, height) = (scene.camera.width, scene.camera.height);
@@ -71,10 +85,12 @@ fn render_to_file(scene: &Scene, args: &RenderArgs) -> anyhow::Result<()> {
         );
     }
     if film.spp == 0 {
-        anyhow::bail!("interrupted before the first sample; nothing written");
+        note!("interrupted before the first sample; nothing written");
+        return Err(Interrupted.into());
     }
     output::write(&film, &args.output)?;
-    if film.spp < total {
+    let stopped = film.spp < total;
+    if stopped {
         note!("interrupted: kept {} of {total} spp", film.spp);
     }
     note!(
@@ -85,5 +101,8 @@ fn render_to_file(scene: &Scene, args: &RenderArgs) -> anyhow::Result<()> {
         progress.samples_per_second(film.spp) / 1e6,
         started.elapsed().as_secs_f64()
     );
+    if stopped {
+        return Err(Interrupted.into());
+    }
     Ok(())
 }

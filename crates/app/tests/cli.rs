@@ -189,23 +189,130 @@ fn unwritable_stderr_still_writes_the_image() {
     assert!(std::fs::metadata(&out).unwrap().len() > 0);
 }
 
-/// Ctrl-C (SIGINT) stops the render between batches and writes what was rendered.
-#[test]
-fn interrupt_keeps_the_rendered_samples() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("interrupted.png");
-    let child = spawn_cpu_render("1000000", &out);
-    std::thread::sleep(std::time::Duration::from_millis(1500));
-    let killed = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+/// Sends `signal` (`INT`, `TERM`, `KILL`) to process `pid`.
+fn send(signal: &str, pid: u32) {
+    let sent = Command::new("kill")
+        .args([&format!("-{signal}"), &pid.to_string()])
         .status()
         .unwrap();
-    assert!(killed.success());
-    let output = child.wait_with_output().unwrap();
-    let err = String::from_utf8_lossy(&output.stderr);
-    assert!(output.status.success(), "{}: {err}", output.status);
-    assert!(err.contains("interrupted: kept"), "{err}");
-    assert!(std::fs::metadata(&out).unwrap().len() > 0);
+    assert!(sent.success());
+}
+
+/// Ctrl-C (SIGINT) and SIGTERM (what `kill`, `timeout`, systemd and job schedulers send)
+/// stop the render between batches; it writes what was rendered, replacing the previous
+/// image, and exits with status 130 so that scripts can tell it from a finished render.
+#[test]
+fn interrupt_keeps_the_rendered_samples() {
+    for signal in ["INT", "TERM"] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("interrupted.png");
+        std::fs::write(&out, "previous").unwrap();
+        let child = spawn_cpu_render("1000000", &out);
+        std::thread::sleep(std::time::Duration::from_millis(1500));
+        send(signal, child.id());
+        let output = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(130), "{signal}: {err}");
+        assert!(
+            err.contains("interrupted: kept") && err.contains("wrote"),
+            "{err}"
+        );
+        let image = image::open(&out).expect("a whole PNG").to_rgb8();
+        assert_eq!(image.dimensions(), (16, 16));
+    }
+}
+
+/// SIGKILL cannot be caught: a render killed before it writes leaves the previous image as
+/// it was, and no stray file beside it.
+#[test]
+fn a_killed_render_leaves_the_previous_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("kept.png");
+    std::fs::write(&out, "previous").unwrap();
+    let child = spawn_cpu_render("1000000", &out);
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    send("KILL", child.id());
+    child.wait_with_output().unwrap();
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "previous");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+/// A signal while the GPU is still being set up loses nothing either: the previous image
+/// stays (or, had the render begun, is replaced by a whole one), never an empty file.
+#[test]
+fn a_signal_during_set_up_loses_nothing() {
+    for signal in ["INT", "TERM"] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("early.png");
+        std::fs::write(&out, "previous").unwrap();
+        let child = Command::new(env!("CARGO_BIN_EXE_pathlight"))
+            .args([
+                "render", "--width", "16", "--height", "16", "--spp", "100000", "-o",
+            ])
+            .arg(&out)
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(100));
+        send(signal, child.id());
+        let output = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(130), "{signal}: {err}");
+        let bytes = std::fs::read(&out).unwrap();
+        assert!(
+            bytes == b"previous" || image::load_from_memory(&bytes).is_ok(),
+            "{signal}: {} bytes that are neither the previous file nor a PNG\n{err}",
+            bytes.len()
+        );
+    }
+}
+
+/// A full disk is an error, and the previous image stays whole (it used to be truncated,
+/// and a small image could even be reported written). A tmpfs of 32 KiB filled up, in a
+/// private mount namespace (`unshare`, util-linux), so the test needs no root.
+#[test]
+fn a_full_disk_keeps_the_previous_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = r#"mount -t tmpfs -o size=32k tmpfs "$1" || exit 99
+printf previous > "$1/out.png"
+dd if=/dev/zero of="$1/fill" bs=1k count=64 2>/dev/null
+"$2" render --backend cpu --width 64 --height 64 --spp 1 -o "$1/out.png" 2>"$1/../stderr"
+echo "status=$?"
+echo "content=$(cat "$1/out.png")"
+ls -A "$1""#;
+    let disk = dir.path().join("disk");
+    std::fs::create_dir(&disk).unwrap();
+    let output = Command::new("unshare")
+        .args([
+            "--user",
+            "--map-root-user",
+            "--mount",
+            "sh",
+            "-c",
+            script,
+            "sh",
+        ])
+        .arg(&disk)
+        .arg(env!("CARGO_BIN_EXE_pathlight"))
+        .output()
+        .expect("unshare (util-linux) runs");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        stdout.contains("status="),
+        "the tmpfs could not be made: {output:?}"
+    );
+    let err = std::fs::read_to_string(dir.path().join("stderr")).unwrap();
+    assert!(stdout.contains("status=1"), "{stdout}\n{err}");
+    assert!(
+        err.contains("No space left on device") && !err.contains("wrote"),
+        "{err}"
+    );
+    assert!(stdout.contains("content=previous"), "{stdout}");
+    assert_eq!(
+        stdout.lines().filter(|l| l.starts_with('.')).count(),
+        0,
+        "{stdout}"
+    );
 }
 
 #[test]

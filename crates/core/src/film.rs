@@ -94,13 +94,21 @@ impl Film {
         })
     }
 
-    /// Writes the film as 32-bit float linear RGB OpenEXR.
-    pub fn write_exr(&self, path: &std::path::Path) -> Result<(), exr::error::Error> {
+    /// The film encoded as 32-bit float linear RGB OpenEXR, in memory (written to disk by
+    /// the caller, who decides how to replace a file safely).
+    pub fn encode_exr(&self) -> Result<Vec<u8>, exr::error::Error> {
+        use exr::prelude::*;
         let width = self.width as usize;
-        exr::prelude::write_rgb_file(path, width, self.height as usize, |x, y| {
-            let [r, g, b] = self.pixels[y * width + x];
+        let channels = SpecificChannels::rgb(|position: Vec2<usize>| {
+            let [r, g, b] = self.pixels[position.y() * width + position.x()];
             (r, g, b)
-        })
+        });
+        let image = Image::from_channels((width, self.height as usize), channels);
+        let mut bytes = Vec::new();
+        image
+            .write()
+            .to_buffered(std::io::Cursor::new(&mut bytes))?;
+        Ok(bytes)
     }
 
     /// Box-downsamples by an integer `factor` (each output pixel is the mean of a
