@@ -30,7 +30,8 @@ const TONEMAP_CLAMP: u32 = 0u;
 const TONEMAP_ACES: u32 = 1u;
 const TONEMAP_AGX: u32 = 2u;
 
-@group(0) @binding(0) var<uniform> display: DisplayParams;
+// Storage, not uniform, for the reason in params.wgsl.
+@group(0) @binding(0) var<storage, read> display: DisplayParams;
 @group(0) @binding(1) var<storage, read> pixels: array<DisplayPixel>;
 
 @vertex

@@ -47,7 +47,7 @@ impl ToneMap {
     }
 }
 
-/// Uniforms of the display pass. WGSL: `DisplayParams`.
+/// Parameters of the display pass (a read-only storage buffer). WGSL: `DisplayParams`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GpuDisplayParams {
@@ -107,7 +107,7 @@ impl DisplayPass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("display"),
             entries: &[
-                entry(0, wgpu::BufferBindingType::Uniform),
+                entry(0, wgpu::BufferBindingType::Storage { read_only: true }),
                 entry(1, wgpu::BufferBindingType::Storage { read_only: true }),
             ],
         });
@@ -140,7 +140,7 @@ impl DisplayPass {
         let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("display params"),
             size: size_of::<GpuDisplayParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         if let Some(err) = pollster::block_on(scope.pop()) {

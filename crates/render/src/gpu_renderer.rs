@@ -102,26 +102,14 @@ impl GpuRenderer {
         let params = GpuRenderParams::new(camera, settings, &scene.shading);
         let accum_size = accumulation_size(device, &params)?;
         let scene_buffers = SceneBuffers::upload(device, scene)?;
-        let frame_layout =
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some("frame layout"),
-                entries: &[
-                    wgpu::BindGroupLayoutEntry {
-                        binding: 0,
-                        visibility: wgpu::ShaderStages::COMPUTE,
-                        ty: wgpu::BindingType::Buffer {
-                            ty: wgpu::BufferBindingType::Uniform,
-                            has_dynamic_offset: false,
-                            min_binding_size: wgpu::BufferSize::new(
-                                size_of::<GpuRenderParams>() as u64
-                            ),
-                        },
-                        count: None,
-                    },
-                    storage_entry(1, false),
-                    storage_entry(2, false),
-                ],
-            });
+        let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("frame layout"),
+            entries: &[
+                storage_entry(0, true),
+                storage_entry(1, false),
+                storage_entry(2, false),
+            ],
+        });
         let stack_size = scene.geometry.stack_bound.next_multiple_of(8);
         let pipeline = integrator_pipeline(
             device,
@@ -133,7 +121,7 @@ impl GpuRenderer {
         let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("render params"),
             size: size_of::<GpuRenderParams>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let accum_buffer = create_accumulation(device, accum_size);
