@@ -46,7 +46,43 @@ def rgb(v):
     return {"type": "rgb", "value": [float(c) for c in v]}
 
 
+# The seed's material presets (docs/scene-format.md): specular_rate, specular_tint,
+# specular_roughness, refract_rate.
+MATERIAL_PRESETS = {"metal": (1.0, 1.0, 0.15, 0.0), "plastic": (0.1, 0.0, 0.25, 0.0),
+                    "wall": (0.0, 0.0, 0.0, 0.0), "glass": (0.0, 0.0, 0.0, 1.0),
+                    "wood": (0.06, 0.0, 0.35, 0.0), "ceramic": (0.2, 0.0, 0.08, 0.0)}
+
+
+def with_preset(m):
+    if "preset" not in m:
+        return m
+    rate, tint, roughness, refract = MATERIAL_PRESETS[m["preset"]]
+    defaults = {"specular_rate": rate, "specular_tint": tint, "specular_roughness": roughness,
+                "refract_rate": refract}
+    return {**defaults, **m}
+
+
+def schlick_white(m):
+    """The Schlick specular lobe when its colour is white (F0 = 1, so F = 1): Mitsuba's
+    conductor with material "none"."""
+    color = m.get("color", [0.8] * 3)
+    if m.get("specular_tint", 0.0) != 0.0 and any(c != 1.0 for c in color):
+        raise SystemExit("a tinted Schlick lobe has no exact Mitsuba equivalent")
+    alpha = m.get("specular_roughness", 0.0) ** 2
+    out = {"type": "conductor", "material": "none"}
+    if alpha >= 1e-3:
+        out.update(type="roughconductor", distribution="ggx", alpha=alpha)
+    return out
+
+
 def bsdf(name, m):
+    m = with_preset(m)
+    rate = m.get("specular_rate", 0.0)
+    if 0.0 < rate and m.get("refract_rate", 0.0) == 0.0 and "conductor" not in m and "eta" not in m:
+        if rate == 1.0:
+            return schlick_white(m)
+        diffuse = bsdf(name, {k: v for k, v in m.items() if k not in ("specular_rate", "preset")})
+        return {"type": "blendbsdf", "weight": rate, "bsdf_0": diffuse, "bsdf_1": schlick_white(m)}
     if m.get("color_space_srgb"):
         raise SystemExit(f"{name}: use color_space = \"linear\" for Mitsuba references")
     alpha_s = m.get("specular_roughness", 0.0) ** 2

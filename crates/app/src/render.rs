@@ -91,7 +91,11 @@ fn render_to_file(
     output::write(&film, &args.output)?;
     let stopped = film.spp < total;
     if stopped {
-        note!("interrupted: kept {} of {total} spp", film.spp);
+        note!(
+            "interrupted: kept {} of {total} spp (rows already sampled in the pass under way \
+             hold one more)",
+            film.spp
+        );
     }
     note!(
         "wrote {}: {width}x{height}, {} spp, render {:.2} s ({:.2} M samples/s), total {:.2} s",

@@ -9,6 +9,7 @@ use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::builder::build_bvh2;
 use obvhs::bvh2::node::Bvh2Node;
+use rayon::slice::ParallelSliceMut;
 
 use crate::gpu_types::{GpuWideNode, SHAPE_LEAF};
 
@@ -23,13 +24,73 @@ pub(crate) struct BinaryTree {
 }
 
 /// Builds the binary tree over `bounds` (not empty) with obvhs' medium preset
-/// (SAH-quality PLOC with reinsertion), on every core.
+/// (SAH-quality PLOC with reinsertion), on every core. Primitives with the very same box
+/// share one leaf: PLOC pairs nearest neighbours and breaks ties one way, so n identical
+/// boxes made a chain n/3 deep in O(n^2) (20,000 coincident triangles: 11 s).
 pub(crate) fn build_binary(bounds: &[Aabb]) -> BinaryTree {
+    let groups = IdenticalBoxes::of(bounds);
     let mut build_time = Duration::ZERO;
-    let tree = build_bvh2(bounds, BvhBuildParams::medium_build(), &mut build_time);
+    if groups.count() == bounds.len() {
+        let tree = build_bvh2(bounds, BvhBuildParams::medium_build(), &mut build_time);
+        return BinaryTree {
+            nodes: tree.nodes,
+            primitive_indices: tree.primitive_indices,
+        };
+    }
+    let unique: Vec<Aabb> = (0..groups.count())
+        .map(|g| bounds[groups.members_of(g as u32)[0] as usize])
+        .collect();
+    let tree = build_bvh2(&unique, BvhBuildParams::medium_build(), &mut build_time);
+    // Each leaf slot of the tree over unique boxes becomes the slots of its group.
+    let mut slot_starts = Vec::with_capacity(tree.primitive_indices.len() + 1);
+    let mut primitive_indices = Vec::with_capacity(bounds.len());
+    for &group in &tree.primitive_indices {
+        slot_starts.push(primitive_indices.len() as u32);
+        primitive_indices.extend_from_slice(groups.members_of(group));
+    }
+    slot_starts.push(primitive_indices.len() as u32);
+    let mut nodes = tree.nodes;
+    for node in nodes.iter_mut().filter(|n| n.prim_count > 0) {
+        let first = slot_starts[node.first_index as usize];
+        node.prim_count = slot_starts[(node.first_index + node.prim_count) as usize] - first;
+        node.first_index = first;
+    }
     BinaryTree {
-        nodes: tree.nodes,
-        primitive_indices: tree.primitive_indices,
+        nodes,
+        primitive_indices,
+    }
+}
+
+/// Primitives grouped by box, bit for bit: group `g` is
+/// `members[starts[g] .. starts[g + 1]]`.
+struct IdenticalBoxes {
+    members: Vec<u32>,
+    starts: Vec<u32>,
+}
+
+impl IdenticalBoxes {
+    fn of(bounds: &[Aabb]) -> Self {
+        let key = |i: u32| {
+            let b = &bounds[i as usize];
+            [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z].map(f32::to_bits)
+        };
+        let mut members: Vec<u32> = (0..bounds.len() as u32).collect();
+        members.par_sort_unstable_by_key(|&i| key(i));
+        let mut starts: Vec<u32> = (0..members.len())
+            .filter(|&i| i == 0 || key(members[i]) != key(members[i - 1]))
+            .map(|i| i as u32)
+            .collect();
+        starts.push(members.len() as u32);
+        Self { members, starts }
+    }
+
+    fn count(&self) -> usize {
+        self.starts.len() - 1
+    }
+
+    fn members_of(&self, group: u32) -> &[u32] {
+        let g = group as usize;
+        &self.members[self.starts[g] as usize..self.starts[g + 1] as usize]
     }
 }
 
@@ -116,27 +177,43 @@ pub fn lane_used(node: &GpuWideNode, lane: usize) -> bool {
     node.lo_x[lane] <= node.hi_x[lane]
 }
 
-/// Most entries the traversal stack of WGSL `trace_scene` can hold at once in the tree
-/// `nodes`. At each node the walk tests the entered leaves that hold shapes at once and
-/// pushes the other entered children but the nearest, and the stack holds only the pending
-/// entries of the current node and its ancestors (an entry is popped before its node is
-/// visited). At least 1: WGSL has no empty arrays.
-pub fn stack_bound(nodes: &[GpuWideNode]) -> u32 {
-    path_pushes(nodes, 0).max(1)
+/// Per node of `nodes` (in pre-order, as [`collapse`] lays them out), its parent's index
+/// times 4 plus its lane there; [`NO_PARENT`] for the root. The GPU walk climbs it when its
+/// traversal stack is full (`trace_stackless` in `bvh.wgsl`).
+pub fn parents(nodes: &[GpuWideNode]) -> Vec<u32> {
+    let mut parents = vec![NO_PARENT; nodes.len()];
+    for (index, node) in nodes.iter().enumerate() {
+        for lane in (0..4).filter(|&lane| lane_used(node, lane) && node.count[lane] == 0) {
+            parents[node.first[lane] as usize] = (index as u32) << 2 | lane as u32;
+        }
+    }
+    parents
 }
 
-/// Most entries pushed along one path down from `node`.
-fn path_pushes(nodes: &[GpuWideNode], node: u32) -> u32 {
-    let n = &nodes[node as usize];
-    let used = (0..4).filter(|&lane| lane_used(n, lane));
-    let pushed = used
-        .clone()
-        .filter(|&lane| n.count[lane] & SHAPE_LEAF == 0)
-        .count() as u32;
-    let below = used
-        .filter(|&lane| n.count[lane] == 0)
-        .map(|lane| path_pushes(nodes, n.first[lane]))
-        .max()
-        .unwrap_or(0);
-    pushed.saturating_sub(1) + below
+/// The root's entry in [`parents`].
+pub const NO_PARENT: u32 = u32::MAX;
+
+/// Most entries the traversal stack of WGSL `trace_scene` needs in the tree `nodes` (in
+/// pre-order) to finish every walk with it. At each node the walk tests the entered leaves
+/// that hold shapes at once and pushes the other entered children but the nearest, and the
+/// stack holds only the pending entries of the current node and its ancestors (an entry is
+/// popped before its node is visited). At least 1: WGSL has no empty arrays.
+pub fn stack_bound(nodes: &[GpuWideNode]) -> u32 {
+    // Most entries pushed along one path down from each node; children come after their
+    // parent in pre-order, so a reverse sweep sees them first (no recursion on deep trees).
+    let mut below = vec![0u32; nodes.len()];
+    for (index, n) in nodes.iter().enumerate().rev() {
+        let used = (0..4).filter(|&lane| lane_used(n, lane));
+        let pushed = used
+            .clone()
+            .filter(|&lane| n.count[lane] & SHAPE_LEAF == 0)
+            .count() as u32;
+        let deepest = used
+            .filter(|&lane| n.count[lane] == 0)
+            .map(|lane| below[n.first[lane] as usize])
+            .max()
+            .unwrap_or(0);
+        below[index] = pushed.saturating_sub(1) + deepest;
+    }
+    below[0].max(1)
 }

@@ -17,14 +17,29 @@ pub struct Film {
 }
 
 impl Film {
-    /// The mean of per-pixel sums of `spp` samples each (the CPU backend's, in f64).
-    pub fn from_sums(width: u32, height: u32, spp: u32, sums: &[[f64; 3]]) -> Self {
-        let scale = 1.0 / f64::from(spp.max(1));
+    /// The mean of per-pixel sums (the CPU backend's, in f64) of `spp` samples each, where
+    /// rows `0 .. rows_ahead` (a pass in progress) hold one sample more.
+    pub fn from_sums(
+        width: u32,
+        height: u32,
+        spp: u32,
+        rows_ahead: u32,
+        sums: &[[f64; 3]],
+    ) -> Self {
+        let pixels = sums
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                let ahead = (i / width as usize) < rows_ahead as usize;
+                let scale = 1.0 / f64::from((spp + u32::from(ahead)).max(1));
+                s.map(|c| (c * scale) as f32)
+            })
+            .collect();
         Self {
             width,
             height,
             spp,
-            pixels: sums.iter().map(|s| s.map(|c| (c * scale) as f32)).collect(),
+            pixels,
         }
     }
 

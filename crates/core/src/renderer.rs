@@ -30,8 +30,10 @@ pub trait Renderer {
     /// Empties the image and the ray count: the next sample is sample 0 again.
     fn restart(&mut self);
 
-    /// Adds up to `max_samples` samples per pixel to every pixel (at least one when
-    /// `max_samples` > 0) in a batch of a fraction of a second; returns how many.
+    /// Works for a fraction of a second towards up to `max_samples` more samples per pixel;
+    /// returns how many samples every pixel gained. Where one sample of the image takes
+    /// longer, it renders the next band of rows of a pass (see [`Self::step_frame`]) and
+    /// returns 1 when the band completes the pass, else 0.
     fn advance(&mut self, max_samples: u32) -> Result<u32, RenderError>;
 
     /// Renders the next part of the current frame (one sample per pixel), taking about

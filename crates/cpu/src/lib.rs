@@ -17,6 +17,7 @@ pub mod sampler;
 pub mod sampling;
 pub mod surface;
 
+use std::ops::Range;
 use std::time::{Duration, Instant};
 
 use pathlight_core::gpu_types::GpuRenderParams;
@@ -41,6 +42,10 @@ pub struct CpuRenderer {
     sums: Vec<[f64; 3]>,
     samples_done: u32,
     batch_samples: u32,
+    /// Rows per `advance` while one pass takes longer than [`TARGET_BATCH`] (else the height).
+    band_rows: u32,
+    /// Rows of the pass in progress that already hold its sample.
+    rows_ahead: u32,
     /// Rays traced and samples dropped as not finite, since the last restart.
     tally: Tally,
     /// The compiled form of the path tracer that runs.
@@ -72,6 +77,8 @@ impl CpuRenderer {
             sums: vec![[0.0; 3]; pixels],
             samples_done: 0,
             batch_samples: 1,
+            band_rows: params.height,
+            rows_ahead: 0,
             tally: Tally::default(),
             isa: InstructionSet::best(),
         }
@@ -90,13 +97,13 @@ impl CpuRenderer {
         Ok(())
     }
 
-    /// Adds `samples` samples per pixel (from sample `samples_done`) to every pixel.
-    fn render(&mut self, samples: u32) {
+    /// Adds `samples` samples per pixel (from sample `samples_done`) to the pixels of `rows`.
+    fn render(&mut self, rows: Range<u32>, samples: u32) {
         let scene = CpuScene::new(&self.scene);
         let (params, isa, offset) = (&self.params, self.isa, self.samples_done);
         let width = params.width as usize;
-        let tally = self
-            .sums
+        let pixels = rows.start as usize * width..rows.end as usize * width;
+        let tally = self.sums[pixels]
             .par_chunks_mut(width)
             .enumerate()
             .map_init(
@@ -105,7 +112,7 @@ impl CpuRenderer {
                     let job = RowJob {
                         scene: &scene,
                         params,
-                        y: y as u32,
+                        y: rows.start + y as u32,
                         samples: offset..offset + samples,
                     };
                     render_row_with(isa, tracer, &job, row)
@@ -113,7 +120,24 @@ impl CpuRenderer {
             )
             .sum::<Tally>();
         self.tally = self.tally + tally;
-        self.samples_done += samples;
+    }
+
+    /// Renders the next band of rows of the pass in progress; returns whether it completed
+    /// the pass. Bands are sized to take about [`TARGET_BATCH`].
+    fn render_band(&mut self) -> bool {
+        let height = self.params.height;
+        let rows = self.band_rows.min(height - self.rows_ahead);
+        let started = Instant::now();
+        self.render(self.rows_ahead..self.rows_ahead + rows, 1);
+        let per_row = started.elapsed().as_secs_f64() / f64::from(rows);
+        self.band_rows = ((TARGET_BATCH.as_secs_f64() / per_row.max(1e-9)) as u32).clamp(1, height);
+        self.rows_ahead += rows;
+        if self.rows_ahead < height {
+            return false;
+        }
+        self.rows_ahead = 0;
+        self.samples_done += 1;
+        true
     }
 }
 
@@ -143,6 +167,7 @@ impl Renderer for CpuRenderer {
     fn restart(&mut self) {
         self.sums.fill([0.0; 3]);
         self.samples_done = 0;
+        self.rows_ahead = 0;
         self.tally = Tally::default();
     }
 
@@ -153,11 +178,19 @@ impl Renderer for CpuRenderer {
         if samples == 0 {
             return Ok(0);
         }
+        if self.rows_ahead > 0 || self.band_rows < self.params.height {
+            return Ok(u32::from(self.render_band()));
+        }
         let started = Instant::now();
-        self.render(samples);
+        self.render(0..self.params.height, samples);
+        self.samples_done += samples;
         let per_sample = started.elapsed().as_secs_f64() / f64::from(samples);
-        self.batch_samples =
-            ((TARGET_BATCH.as_secs_f64() / per_sample.max(1e-9)) as u32).clamp(1, 1024);
+        let per_target = TARGET_BATCH.as_secs_f64() / per_sample.max(1e-9);
+        self.batch_samples = (per_target as u32).clamp(1, 1024);
+        // A pass longer than the target: bands of rows from now on, so that an interrupt
+        // waits for a fraction of a second.
+        self.band_rows =
+            ((f64::from(self.params.height) * per_target) as u32).clamp(1, self.params.height);
         Ok(samples)
     }
 
@@ -168,7 +201,8 @@ impl Renderer for CpuRenderer {
     }
 
     fn queue_frame(&mut self) -> Result<(), RenderError> {
-        self.render(1);
+        self.render(0..self.params.height, 1);
+        self.samples_done += 1;
         Ok(())
     }
 
@@ -194,7 +228,49 @@ impl Renderer for CpuRenderer {
             width,
             height,
             self.samples_done,
+            self.rows_ahead,
             &self.sums,
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use pathlight_core::{PreparedScene, Renderer};
+    use pathlight_scene::default_scene;
+
+    use super::CpuRenderer;
+
+    /// A pass cut in bands of rows (as when one pass takes longer than a batch) gives the
+    /// pixels of whole passes, and mid-pass the rows already sampled hold their own mean.
+    #[test]
+    fn passes_in_bands_keep_the_image_exact() {
+        let mut scene = default_scene::load().unwrap();
+        scene.camera.width = 12;
+        scene.camera.height = 10;
+        let prepared = PreparedScene::new(&scene).unwrap();
+        let whole = |spp: u32| {
+            let mut r = CpuRenderer::new(&prepared, &scene.camera, &scene.settings);
+            while r.samples_done() < spp {
+                r.advance(spp - r.samples_done()).unwrap();
+            }
+            r.film().unwrap()
+        };
+        let (one, two) = (whole(1), whole(2));
+        let mut banded = CpuRenderer::new(&prepared, &scene.camera, &scene.settings);
+        banded.advance(1).unwrap();
+        banded.band_rows = 4;
+        // Bands of 4, 4 and 2 rows complete the second pass.
+        assert_eq!(banded.advance(1).unwrap(), 0);
+        assert_eq!(banded.rows_ahead, 4);
+        let mid = banded.film().unwrap();
+        let split = 4 * 12;
+        assert_eq!(mid.pixels[..split], two.pixels[..split], "rows ahead");
+        assert_eq!(mid.pixels[split..], one.pixels[split..], "rows behind");
+        banded.band_rows = 4;
+        assert_eq!(banded.advance(1).unwrap(), 0);
+        banded.band_rows = 4;
+        assert_eq!(banded.advance(1).unwrap(), 1);
+        assert_eq!(banded.film().unwrap(), two);
     }
 }

@@ -4,7 +4,8 @@
 // four child boxes are tested at once. The entered leaves that hold shapes (SHAPE_LEAF) are
 // tested at once; the other entered children (inner nodes, leaves of triangles as LEAF
 // entries) are sorted, the nearest is taken next and the others are pushed with their entry
-// distances, nearest on top, to be skipped on pop if a closer hit was found meanwhile.
+// distances, nearest on top, to be skipped on pop if a closer hit was found meanwhile. A walk
+// that would overflow the stack (the host caps it) starts again without one.
 // Leaves of triangles are tested in a loop of their own. Shadow rays stop at the first hit.
 // CPU twin: `crates/cpu/src/bvh.rs` (whose walk tests a node's leaves as it visits the node;
 // the hits are the same).
@@ -22,7 +23,8 @@ const ACCEL_BRUTE_FORCE: u32 = 2u;
 override ACCEL: u32 = 0u;
 
 // Entries of the traversal stack: the host sizes it to the scene's tree
-// (`pathlight_core::bvh::stack_bound`, rounded up to 8) when it assembles the module.
+// (`pathlight_core::bvh::stack_bound`, rounded up to 8, at most `MAX_STACK` in
+// `gpu_renderer.rs`) when it assembles the module.
 #const STACK_SIZE: u32
 const NO_HIT: u32 = 0xffffffffu;
 // Stack entry tag (an untagged entry is an inner node): a leaf child, node << 2 | lane in
@@ -208,15 +210,21 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
         order_pair(&k0, &c0, &k2, &c2);
         order_pair(&k1, &c1, &k3, &c3);
         order_pair(&k1, &c1, &k2, &c2);
-        if k3 != MISS && sp < STACK_SIZE {
+        let pushes = u32(k1 != MISS) + u32(k2 != MISS) + u32(k3 != MISS);
+        if sp + pushes > STACK_SIZE {
+            // Deeper than the stack: walk again from the root without one, keeping the hit.
+            trace_stackless(ray, sheared, inv_dir, backwards, any_hit, &hit);
+            return hit;
+        }
+        if k3 != MISS {
             stack[sp] = vec2u(c3, bitcast<u32>(k3));
             sp++;
         }
-        if k2 != MISS && sp < STACK_SIZE {
+        if k2 != MISS {
             stack[sp] = vec2u(c2, bitcast<u32>(k2));
             sp++;
         }
-        if k1 != MISS && sp < STACK_SIZE {
+        if k1 != MISS {
             stack[sp] = vec2u(c1, bitcast<u32>(k1));
             sp++;
         }
@@ -244,6 +252,52 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
         index = next;
     }
     return hit;
+}
+
+// The walk of `trace_scene` for trees deeper than its stack: children in lane order, going
+// down to the first entered inner child and back up through `parents` to the next one, so it
+// needs no stack (Hapala et al. 2011, "Efficient stack-less BVH traversal for ray tracing",
+// on a 4-wide tree). A node's entered leaves are tested when the walk first reaches it. It
+// updates `hit` (which may already hold a hit) and stops at the first hit with `any_hit`.
+fn trace_stackless(ray: Ray, sheared: ShearedRay, inv_dir: vec3f, backwards: vec3<bool>, any_hit: bool, hit: ptr<function, Hit>) {
+    var index = 0u;
+    // The lane of the child the walk came up from; 4 when it came down.
+    var from_lane = 4u;
+    loop {
+        let n = nodes[index];
+        let t = enter_children(n, ray.origin, inv_dir, backwards, (*hit).t);
+        if from_lane == 4u {
+            for (var lane = 0u; lane < 4u; lane++) {
+                if n.count[lane] == 0u || t[lane] >= (*hit).t {
+                    continue;
+                }
+                let first = n.first[lane];
+                let end = first + (n.count[lane] & ~SHAPE_LEAF);
+                for (var i = first; i < end; i++) {
+                    intersect_primitive(i, ray, sheared, hit);
+                }
+            }
+            if any_hit && (*hit).object != NO_HIT {
+                return;
+            }
+        }
+        var next = NO_NODE;
+        for (var lane = select(from_lane + 1u, 0u, from_lane == 4u); lane < 4u; lane++) {
+            if n.count[lane] == 0u && t[lane] < (*hit).t {
+                next = n.first[lane];
+                break;
+            }
+        }
+        if next != NO_NODE {
+            index = next;
+            from_lane = 4u;
+        } else if index == 0u {
+            return;
+        } else {
+            from_lane = parents[index] & 3u;
+            index = parents[index] >> 2u;
+        }
+    }
 }
 
 // Pops the next entry whose subtree may hold a hit nearer than `t` and returns it (an inner

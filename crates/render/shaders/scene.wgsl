@@ -112,3 +112,5 @@ struct TextureInfo {
 @group(0) @binding(6) var<storage, read> lights: array<Light>;
 // The BVH's leaves index these.
 @group(0) @binding(7) var<storage, read> primitives: array<Primitive>;
+// Per BVH node, its parent's index << 2 | its lane there (`pathlight_core::bvh::parents`).
+@group(0) @binding(8) var<storage, read> parents: array<u32>;

@@ -19,6 +19,10 @@ use crate::wgsl;
 pub const TARGET_SUBMISSION: Duration = Duration::from_millis(100);
 /// Most samples per pixel one dispatch adds.
 const MAX_BATCH_SAMPLES: u32 = 256;
+/// Most entries of the compiled traversal stack. Deeper trees' walks that would overflow it
+/// start again without a stack (`trace_stackless` in `bvh.wgsl`): a stack of hundreds of
+/// entries made lavapipe's first batch take minutes.
+pub const MAX_STACK: u32 = 64;
 /// Workgroup edge of the integrator (`@workgroup_size(8, 8)`).
 const WORKGROUP: u32 = 8;
 
@@ -110,7 +114,11 @@ impl GpuRenderer {
                 storage_entry(2, false),
             ],
         });
-        let stack_size = scene.geometry.stack_bound.next_multiple_of(8);
+        let stack_size = scene
+            .geometry
+            .stack_bound
+            .next_multiple_of(8)
+            .min(MAX_STACK);
         let pipeline = integrator_pipeline(
             device,
             &scene_buffers.layout,
@@ -159,8 +167,8 @@ impl GpuRenderer {
         })
     }
 
-    /// Fixes the piece size (rows per dispatch, samples per pixel per dispatch) instead of
-    /// sizing pieces from the measured speed. The image does not depend on it: samples are
+    /// Fixes the piece size (rows per dispatch; samples per pixel per dispatch when it covers
+    /// every row, else one) instead of sizing pieces from the measured speed. The image does not depend on it: samples are
     /// seeded per (pixel, index) and summed exactly.
     pub fn set_piece(&mut self, rows: u32, samples: u32) {
         self.rows_per_dispatch = rows.clamp(1, self.params.height);
@@ -322,21 +330,20 @@ impl Renderer for GpuRenderer {
         self.rows_ahead = 0;
     }
 
-    /// Submits pieces of about [`TARGET_SUBMISSION`] each.
+    /// One submission of about [`TARGET_SUBMISSION`]: samples over the whole image, or, when
+    /// one sample of the image takes longer, the next band of rows of the pass in progress.
     fn advance(&mut self, max_samples: u32) -> Result<u32, RenderError> {
         let samples = self.batch_samples.min(max_samples);
         if samples == 0 {
             return Ok(0);
         }
-        let height = self.params.height;
-        let started = Instant::now();
-        let mut row = 0;
-        while row < height {
-            let rows = self.rows_per_dispatch.min(height - row);
-            self.submit(row, rows, samples);
-            self.wait()?;
-            row += rows;
+        if self.rows_ahead > 0 || self.rows_per_dispatch < self.params.height {
+            let done = self.step_frame(TARGET_SUBMISSION)?;
+            return Ok(u32::from(done));
         }
+        let started = Instant::now();
+        self.submit(0, self.params.height, samples);
+        self.wait()?;
         self.samples_done += samples;
         if self.adaptive {
             self.reschedule(started.elapsed(), samples);
@@ -354,11 +361,14 @@ impl Renderer for GpuRenderer {
         self.wait()?;
         let elapsed = started.elapsed();
         self.rows_ahead += rows;
-        // Next band: scale by the measured time, in whole workgroups of rows.
-        let scale = target.as_secs_f64() / elapsed.as_secs_f64().max(1e-6);
-        let workgroups = (f64::from(rows) * scale.clamp(0.5, 2.0) / f64::from(WORKGROUP)).round();
-        self.rows_per_dispatch =
-            (workgroups as u32 * WORKGROUP).clamp(WORKGROUP.min(height), height);
+        if self.adaptive {
+            // Next band: scale by the measured time, in whole workgroups of rows.
+            let scale = target.as_secs_f64() / elapsed.as_secs_f64().max(1e-6);
+            let workgroups =
+                (f64::from(rows) * scale.clamp(0.5, 2.0) / f64::from(WORKGROUP)).round();
+            self.rows_per_dispatch =
+                (workgroups as u32 * WORKGROUP).clamp(WORKGROUP.min(height), height);
+        }
         if self.rows_ahead < height {
             return Ok(false);
         }

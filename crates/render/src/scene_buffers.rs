@@ -13,7 +13,7 @@ use crate::pipeline::{bind_buffers, storage_entry};
 const MAX_NODES: usize = 1 << 28;
 
 /// Bindings of `scene.wgsl`, by number.
-const BINDINGS: usize = 8;
+const BINDINGS: usize = 9;
 
 /// The scene's buffers on the device and the bind group over them.
 #[derive(Debug)]
@@ -49,8 +49,9 @@ fn storage_buffer(
     )
 }
 
-/// The geometry buffers: bindings 0 (nodes), 2 (vertices) and 7 (primitives).
-fn geometry_contents(geometry: &Geometry) -> [(usize, &'static str, &[u8]); 3] {
+/// The geometry buffers: bindings 0 (nodes), 2 (vertices), 7 (primitives) and 8 (the
+/// nodes' parents).
+fn geometry_contents(geometry: &Geometry) -> [(usize, &'static str, &[u8]); 4] {
     // A binding is never empty: a placeholder when there are no primitives.
     const PLACEHOLDER: [GpuPrimitive; 1] = [GpuPrimitive {
         v0: [0.0; 3],
@@ -69,6 +70,7 @@ fn geometry_contents(geometry: &Geometry) -> [(usize, &'static str, &[u8]); 3] {
         (0, "bvh nodes", bytemuck::cast_slice(&geometry.nodes)),
         (2, "vertices", bytemuck::cast_slice(&geometry.vertices)),
         (7, "primitives", primitives),
+        (8, "bvh parents", bytemuck::cast_slice(&geometry.parents)),
     ]
 }
 

@@ -2,6 +2,7 @@
 
 mod common;
 mod extreme;
+mod furnace;
 mod render;
 mod trace;
 mod twin;
