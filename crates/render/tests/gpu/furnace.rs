@@ -1,8 +1,8 @@
 //! Furnace rings: a sphere of every BSDF configuration (Lambert, smooth and rough conductors,
 //! smooth and rough glass at three roughness values, the seed's presets in white) under a
 //! constant environment of radiance 1, checked on both backends in three rings of the
-//! sphere (centre, middle, rim) against Mitsuba 3.9.1 (`scenes/refs/furnace-NAME.toml`,
-//! images in `scenes/refs/images/`). Whole-image means hid a +1.7% rim on rough glass.
+//! sphere (centre, middle, rim) against Mitsuba 3.9.1 (the scenes `furnace-<name>.toml` in
+//! `scenes/refs/`, their images in `scenes/refs/images/`). Whole-image means hid a +1.7% rim on rough glass.
 
 use pathlight_core::Film;
 
