@@ -48,7 +48,7 @@ fn shipped_scenes_load() {
             }
         }
     }
-    assert_eq!(found, 7, "default + six reference scenes");
+    assert_eq!(found, 20, "default + six reference scenes + 13 furnace rings");
 }
 
 #[test]
