@@ -48,7 +48,10 @@ fn shipped_scenes_load() {
             }
         }
     }
-    assert_eq!(found, 20, "default + six reference scenes + 13 furnace rings");
+    assert_eq!(
+        found, 20,
+        "default + six reference scenes + 13 furnace rings"
+    );
 }
 
 #[test]
