@@ -26,21 +26,7 @@ impl Film {
         rows_ahead: u32,
         sums: &[[f64; 3]],
     ) -> Self {
-        let pixels = sums
-            .iter()
-            .enumerate()
-            .map(|(i, s)| {
-                let ahead = (i / width as usize) < rows_ahead as usize;
-                let scale = 1.0 / f64::from((spp + u32::from(ahead)).max(1));
-                s.map(|c| (c * scale) as f32)
-            })
-            .collect();
-        Self {
-            width,
-            height,
-            spp,
-            pixels,
-        }
+        Self::from_pixel_sums(width, height, spp, rows_ahead, sums.iter().copied())
     }
 
     /// The mean of the GPU's fixed-point sums ([`GpuAccumPixel`]) of `spp` samples per
@@ -52,13 +38,25 @@ impl Film {
         rows_ahead: u32,
         sums: &[GpuAccumPixel],
     ) -> Self {
+        let sums = sums.iter().map(|a| [0, 1, 2].map(|c| a.channel_sum(c)));
+        Self::from_pixel_sums(width, height, spp, rows_ahead, sums)
+    }
+
+    /// Divides each row-major pixel sum by its sample count: `spp`, one more in rows
+    /// `0 .. rows_ahead`.
+    fn from_pixel_sums(
+        width: u32,
+        height: u32,
+        spp: u32,
+        rows_ahead: u32,
+        sums: impl Iterator<Item = [f64; 3]>,
+    ) -> Self {
         let pixels = sums
-            .iter()
             .enumerate()
-            .map(|(i, a)| {
+            .map(|(i, sum)| {
                 let ahead = (i / width as usize) < rows_ahead as usize;
                 let scale = 1.0 / f64::from((spp + u32::from(ahead)).max(1));
-                [0, 1, 2].map(|c| (a.channel_sum(c) * scale) as f32)
+                sum.map(|c| (c * scale) as f32)
             })
             .collect();
         Self {

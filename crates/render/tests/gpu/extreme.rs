@@ -9,7 +9,7 @@ use pathlight_core::gpu_types::GpuRenderParams;
 use pathlight_cpu::integrator::trace_path;
 use pathlight_cpu::sampler::Sampler;
 use pathlight_cpu::{CpuScene, Tracer};
-use pathlight_scene::{SceneSource, load_scene};
+use pathlight_scene::{Scene, SceneSource, load_scene};
 
 use crate::common::{gpu_renderer, render, render_counting_dropped, render_cpu};
 
@@ -87,15 +87,20 @@ p1 = [0.3, -0.2, 0.5]
 radius = 0.2
 "#;
 
-#[test]
-fn extreme_values_give_finite_samples_on_both_backends() {
-    let mut s = load_scene(&SceneSource {
+/// The scene of extreme legal values above.
+fn extreme_scene() -> Scene {
+    load_scene(&SceneSource {
         name: "extreme".into(),
         text: SCENE,
         base_dir: ".".into(),
         embedded: &[],
     })
-    .unwrap();
+    .unwrap()
+}
+
+#[test]
+fn extreme_values_give_finite_samples_on_both_backends() {
+    let mut s = extreme_scene();
     // The camera looks along the floor plane: y = 0 exactly.
     s.camera.position.y = 0.0;
     s.camera.look_at.y = 0.0;
@@ -138,13 +143,7 @@ fn extreme_values_give_finite_samples_on_both_backends() {
 /// the image stays finite.
 #[test]
 fn non_finite_samples_are_counted_on_both_backends() {
-    let mut s = load_scene(&SceneSource {
-        name: "extreme".into(),
-        text: SCENE,
-        base_dir: ".".into(),
-        embedded: &[],
-    })
-    .unwrap();
+    let mut s = extreme_scene();
     s.camera.width = 16;
     s.camera.height = 16;
     s.settings.spp = 2;
