@@ -4,7 +4,7 @@
 use anyhow::Context;
 use pathlight_core::{PreparedScene, Renderer};
 use pathlight_cpu::{CpuRenderer, InstructionSet};
-use pathlight_render::context::describe;
+use pathlight_render::context::{AutoChoice, auto_choice, available_adapters, describe};
 use pathlight_render::{Accel, GpuContext, GpuRenderer};
 use pathlight_scene::settings::{check_max_depth, check_resolution};
 use pathlight_scene::{Sampler, Scene, default_scene, load_scene_file};
@@ -54,12 +54,32 @@ pub enum Device {
 }
 
 impl Device {
-    /// Opens the device the arguments ask for.
+    /// Opens the device the arguments ask for; `--backend auto` says what it chose and why.
     pub fn open(args: &DeviceArgs) -> anyhow::Result<Self> {
-        Ok(match args.backend {
-            Backend::Gpu => Device::Gpu(GpuContext::new(args.adapter.as_deref())?),
-            Backend::Cpu => Device::Cpu,
+        Ok(match (args.backend, args.adapter.as_deref()) {
+            (Backend::Gpu, name) | (Backend::Auto, name @ Some(_)) => {
+                Device::Gpu(GpuContext::new(name)?)
+            }
+            (Backend::Cpu, _) => Device::Cpu,
+            (Backend::Auto, None) => {
+                let adapters = available_adapters();
+                let infos: Vec<_> = adapters.iter().map(|a| a.get_info()).collect();
+                let choice = auto_choice(&infos);
+                note!("{}", explain(choice, &infos));
+                match choice {
+                    AutoChoice::Gpu(i) => Device::Gpu(GpuContext::from_adapter(&adapters[i])?),
+                    AutoChoice::Cpu(_) => Device::Cpu,
+                }
+            }
         })
+    }
+
+    /// The backend it is, as `--backend` names it.
+    pub fn backend_name(&self) -> &'static str {
+        match self {
+            Device::Gpu(_) => "gpu",
+            Device::Cpu => "cpu",
+        }
     }
 
     /// Where rendering runs, for messages and reports: the adapter, or the CPU backend.
@@ -87,5 +107,23 @@ impl Device {
             ),
             Device::Cpu => Box::new(CpuRenderer::new(prepared, camera, settings)),
         })
+    }
+}
+
+/// Why `--backend auto` chose what it did, in one line.
+pub fn explain(choice: AutoChoice, adapters: &[wgpu::AdapterInfo]) -> String {
+    match choice {
+        AutoChoice::Gpu(i) => format!(
+            "hardware GPU found: using the GPU backend on {}",
+            adapters[i].name
+        ),
+        AutoChoice::Cpu(software) => {
+            let cpu = pathlight_cpu::threads_and_level(InstructionSet::best());
+            let forced = match software {
+                Some(i) => format!("--backend gpu forces {}", adapters[i].name),
+                None => "no adapter for --backend gpu".to_string(),
+            };
+            format!("no hardware GPU found: using the CPU backend ({cpu}); {forced}")
+        }
     }
 }

@@ -61,7 +61,10 @@ struct Report {
     pathlight: &'static str,
     scene: String,
     device: String,
+    /// The backend that ran (`gpu` or `cpu`).
     backend: String,
+    /// The backend asked for (`auto`, `gpu` or `cpu`).
+    backend_asked: String,
     runs: Vec<Measurement>,
 }
 
@@ -89,7 +92,8 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<()> {
             None => "default".into(),
         },
         device: device.describe(),
-        backend: format!("{:?}", args.device.backend).to_lowercase(),
+        backend: device.backend_name().to_string(),
+        backend_asked: format!("{:?}", args.device.backend).to_lowercase(),
         runs: Vec::new(),
     };
     for (i, (label, accel, without, seed_fps)) in configs.into_iter().enumerate() {
@@ -211,10 +215,7 @@ fn print_single(report: &Report) {
         format!(", without {}", m.without.join(", "))
     };
     println!("scene        {}{without}", report.scene);
-    println!(
-        "device       {} ({} backend)",
-        report.device, report.backend
-    );
+    println!("device       {}", report.device_line());
     println!(
         "settings     {}x{}, max_depth {}, 1 spp per frame, accel {}",
         m.width, m.height, m.max_depth, m.accel
@@ -239,6 +240,18 @@ fn print_single(report: &Report) {
     );
 }
 
+impl Report {
+    /// Where it ran and which backend, noting an automatic choice.
+    fn device_line(&self) -> String {
+        let chosen = if self.backend_asked == "auto" {
+            ", chosen by --backend auto"
+        } else {
+            ""
+        };
+        format!("{} ({} backend{chosen})", self.device, self.backend)
+    }
+}
+
 /// One cell of the seed table from a measurement.
 type Cell = fn(&Measurement) -> String;
 
@@ -248,7 +261,7 @@ fn print_seed_table(report: &Report) {
         "{} scene, {}x{}, max_depth {}, 1 spp per frame",
         report.scene, first.width, first.height, first.max_depth
     );
-    println!("device: {} ({} backend)", report.device, report.backend);
+    println!("device: {}", report.device_line());
     print!("{:<18}", "");
     for m in &report.runs {
         print!("{:>17}", m.label);

@@ -29,6 +29,9 @@ pub enum Command {
 /// Where the light transport runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum Backend {
+    /// A hardware GPU when there is one, else the CPU backend (Mesa's software adapters
+    /// run the WGSL several times slower than the CPU backend).
+    Auto,
     /// WGSL compute shaders on a wgpu adapter (a GPU, or lavapipe/llvmpipe without one).
     Gpu,
     /// The same transport in native Rust on all CPU cores (rayon).
@@ -68,13 +71,15 @@ pub enum SamplerChoice {
 }
 
 /// Which device renders.
-#[derive(Debug, clap::Args)]
+#[derive(Debug, Clone, clap::Args)]
 pub struct DeviceArgs {
     /// Where the light transport runs.
-    #[arg(long, value_enum, default_value_t = Backend::Gpu)]
+    #[arg(long, value_enum, default_value_t = Backend::Auto)]
     pub backend: Backend,
     /// Use the adapter whose name contains this text (any case), or a backend name
-    /// (`vulkan`, `gl`, ...). `WGPU_BACKEND=vulkan,gl` restricts the backends searched.
+    /// (`vulkan`, `gl`, ...); with `--backend auto`, naming one asks for the GPU backend
+    /// (the viewer presents on it whatever the backend). `WGPU_BACKEND=vulkan,gl` restricts
+    /// the backends searched.
     #[arg(long, value_name = "NAME")]
     pub adapter: Option<String>,
 }
@@ -169,9 +174,8 @@ pub struct ViewArgs {
     /// Where `S` saves images.
     #[arg(long, default_value = ".", value_name = "DIR")]
     pub save_dir: PathBuf,
-    /// Use the adapter whose name contains this text (any case), or a backend name.
-    #[arg(long, value_name = "NAME")]
-    pub adapter: Option<String>,
+    #[command(flatten)]
+    pub device: DeviceArgs,
 }
 
 impl ViewArgs {
@@ -190,7 +194,10 @@ impl ViewArgs {
             iters: 8,
             light_strength: None,
             save_dir: ".".into(),
-            adapter: None,
+            device: DeviceArgs {
+                backend: Backend::Auto,
+                adapter: None,
+            },
         }
     }
 }

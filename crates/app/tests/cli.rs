@@ -69,7 +69,10 @@ fn furnace_exr_reads_albedo_and_background() {
     ]);
     let err = stderr(&output);
     assert!(output.status.success(), "{err}");
-    assert!(err.contains("adapter: "), "the adapter is printed:\n{err}");
+    assert!(
+        err.contains("adapter: ") || err.contains("backend: cpu backend"),
+        "where it renders is printed:\n{err}"
+    );
     let film = pathlight_core::Film::read_exr(&out).unwrap();
     let (width, pixels) = (film.width as usize, film.pixels);
     assert_eq!((width, pixels.len()), (64, 64 * 64));
@@ -140,9 +143,10 @@ fn bad_outputs_are_refused_before_rendering() {
         &["render", "-o", "/no/such/dir/out.png"],
         &["/no/such/dir/out.png", "not writable"],
     );
-    assert!(!err.contains("adapter:"), "rendering started:\n{err}");
+    let started = |err: &str| err.contains("adapter:") || err.contains("backend:");
+    assert!(!started(&err), "rendering started:\n{err}");
     let err = fails_with(&["render", "-o", "out.jpg"], &["out.jpg", ".png or .exr"]);
-    assert!(!err.contains("adapter:"), "rendering started:\n{err}");
+    assert!(!started(&err), "rendering started:\n{err}");
 }
 
 #[test]
@@ -151,28 +155,90 @@ fn adapter_choice_errors_are_clear() {
         &["render", "--spp", "1", "--adapter", "no-such-gpu"],
         &["no adapter matches \"no-such-gpu\"", "found:"],
     );
-    // DX12 does not exist on Linux: the same as a machine without any adapter.
-    let output = Command::new(env!("CARGO_BIN_EXE_pathlight"))
-        .args([
-            "render",
-            "--spp",
-            "1",
-            "-o",
-            "/tmp/pathlight-no-adapter.png",
-        ])
-        .env("WGPU_BACKEND", "dx12")
-        .output()
-        .unwrap();
+    // DX12 does not exist on Linux: the same as a machine without any adapter. The GPU
+    // backend fails, saying what to install; the default renders on the CPU backend.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("no-adapter.png");
+    let render = |backend: &str| {
+        Command::new(env!("CARGO_BIN_EXE_pathlight"))
+            .args(["render", "--backend", backend, "--spp", "1"])
+            .args(["--width", "16", "--height", "16", "-o"])
+            .arg(&out)
+            .env("WGPU_BACKEND", "dx12")
+            .output()
+            .unwrap()
+    };
+    let output = render("gpu");
     assert_eq!(output.status.code(), Some(1));
     let err = stderr(&output);
     assert!(
         err.contains("no GPU adapter found") && err.contains("mesa-vulkan-drivers"),
         "{err}"
     );
+    assert!(!out.exists(), "a failed render leaves no empty file");
+    let output = render("auto");
+    let err = stderr(&output);
+    assert!(output.status.success(), "{err}");
     assert!(
-        !Path::new("/tmp/pathlight-no-adapter.png").exists(),
-        "a failed render leaves no empty file"
+        err.contains("no hardware GPU found: using the CPU backend")
+            && err.contains("no adapter for --backend gpu"),
+        "{err}"
     );
+    assert!(out.exists());
+}
+
+/// Whether `pathlight render --list-adapters` lists a hardware GPU (an adapter that is not
+/// of type `Cpu`).
+fn hardware_gpu_listed() -> bool {
+    let output = pathlight(&["render", "--list-adapters"]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    String::from_utf8_lossy(&output.stdout)
+        .lines()
+        .any(|line| !line.contains(", Cpu, "))
+}
+
+/// `--backend auto` (the default) renders on a hardware GPU when there is one, else on the
+/// CPU backend, and says which and why. On CI (software adapters only) that is the CPU
+/// backend.
+#[test]
+fn auto_backend_says_what_it_chose() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("auto.png");
+    let output = pathlight(&[
+        "render",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--spp",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let err = stderr(&output);
+    assert!(output.status.success(), "{err}");
+    if hardware_gpu_listed() {
+        assert!(
+            err.contains("hardware GPU found: using the GPU backend on")
+                && err.contains("adapter: "),
+            "{err}"
+        );
+    } else {
+        assert!(
+            err.contains("no hardware GPU found: using the CPU backend (")
+                && err.contains("--backend gpu forces")
+                && err.contains("backend: cpu backend"),
+            "{err}"
+        );
+    }
+    let output = pathlight(&[
+        "bench", "--width", "16", "--height", "16", "--frames", "1", "--warmup", "0", "--json",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let report: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
+    assert_eq!(report["backend_asked"], "auto");
+    let expected = if hardware_gpu_listed() { "gpu" } else { "cpu" };
+    assert_eq!(report["backend"], expected, "{report}");
 }
 
 /// A stderr that cannot be written (a closed pipe, `2>&1 | head -1`) neither panics nor
@@ -352,6 +418,7 @@ fn bench_reports_consistent_figures_as_json() {
     assert!(output.status.success(), "{}", stderr(&output));
     let report: serde_json::Value = serde_json::from_slice(&output.stdout).expect("JSON");
     assert_eq!(report["backend"], "cpu");
+    assert_eq!(report["backend_asked"], "cpu");
     let run = &report["runs"][0];
     assert_eq!(run["frames"], 3);
     assert_eq!(run["triangles"], 6208, "the default scene's vase");

@@ -1,7 +1,8 @@
 //! `pathlight view` end to end under a real X server: Xvfb, with xdotool for the mouse and
 //! keys and ImageMagick's `import` for screenshots (Debian packages `xvfb`, `xdotool`,
-//! `imagemagick`; `.ci/run` installs them). The viewer renders on whatever adapter presents
-//! to the window (lavapipe on CI).
+//! `imagemagick`; `.ci/run` installs them). Each test runs on both backends: the GPU one on
+//! whatever adapter presents to the window (lavapipe on CI), the CPU one on its own thread,
+//! presenting through that adapter.
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -37,29 +38,34 @@ struct XServer {
 impl XServer {
     fn start() -> Self {
         require("Xvfb");
-        let number = (90..200)
-            .find(|n| {
-                !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
-                    && !Path::new(&format!("/tmp/.X{n}-lock")).exists()
-            })
-            .expect("a free X display number");
-        let display = format!(":{number}");
-        let process = Command::new("Xvfb")
-            .args([&display, "-screen", "0", "320x240x24", "-nolisten", "tcp"])
-            .stdout(Stdio::null())
+        // Xvfb picks a free display number itself and writes it to standard output (tests
+        // run in parallel: probing for a free number raced).
+        let mut process = Command::new("Xvfb")
+            .args([
+                "-displayfd",
+                "1",
+                "-screen",
+                "0",
+                "320x240x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdout(Stdio::piped())
             .stderr(Stdio::null())
             .spawn()
             .expect("Xvfb starts");
-        let socket = format!("/tmp/.X11-unix/X{number}");
-        let started = Instant::now();
-        while !Path::new(&socket).exists() {
-            assert!(
-                started.elapsed() < Duration::from_secs(20),
-                "Xvfb did not come up"
-            );
-            std::thread::sleep(Duration::from_millis(50));
+        let mut line = String::new();
+        BufReader::new(process.stdout.take().unwrap())
+            .read_line(&mut line)
+            .expect("Xvfb writes its display number");
+        let number: u32 = line
+            .trim()
+            .parse()
+            .unwrap_or_else(|_| panic!("Xvfb wrote {line:?}, not a display number"));
+        Self {
+            display: format!(":{number}"),
+            process,
         }
-        Self { display, process }
     }
 
     /// Runs an X client (xdotool, import) on this display; returns its stdout.
@@ -94,9 +100,9 @@ struct Viewer {
 }
 
 impl Viewer {
-    fn start(x: &XServer, scene: &Path, save_dir: &Path) -> Self {
+    fn start(x: &XServer, scene: &Path, save_dir: &Path, backend: &str) -> Self {
         let mut process = Command::new(env!("CARGO_BIN_EXE_pathlight"))
-            .arg("view")
+            .args(["view", "--backend", backend])
             .arg(scene)
             .args(["--width", "64", "--height", "64", "--frames-per-iter", "3"])
             .args(["--iters", "2", "--save-dir"])
@@ -221,10 +227,24 @@ fn ball_scene(dir: &Path) -> PathBuf {
 }
 
 #[test]
-fn viewer_iterates_waits_for_right_clicks_picks_and_saves() {
+fn viewer_on_the_gpu_backend() {
+    iterates_waits_for_right_clicks_picks_saves_and_drags("gpu");
+}
+
+#[test]
+fn viewer_on_the_cpu_backend() {
+    iterates_waits_for_right_clicks_picks_saves_and_drags("cpu");
+}
+
+fn iterates_waits_for_right_clicks_picks_saves_and_drags(backend: &str) {
     let x = XServer::start();
     let dir = tempfile::tempdir().unwrap();
-    let mut viewer = Viewer::start(&x, &ball_scene(dir.path()), dir.path());
+    let mut viewer = Viewer::start(&x, &ball_scene(dir.path()), dir.path(), backend);
+    let expected = match backend {
+        "cpu" => "backend: cpu backend",
+        _ => "adapter: ",
+    };
+    assert!(viewer.wait_for(expected, 1).starts_with(expected));
 
     // Iteration 1 runs at once and reports its frame rate.
     let line = viewer.wait_for("iter 1 finished", 1);
@@ -246,6 +266,12 @@ fn viewer_iterates_waits_for_right_clicks_picks_and_saves() {
         title.contains("iter 1/2") && title.contains("right-click"),
         "{title}"
     );
+    if backend == "cpu" {
+        assert!(
+            title.contains("cpu backend"),
+            "the title names the backend: {title}"
+        );
+    }
     x.run(
         "xdotool",
         &["mousemove", "--window", &window, "10", "10", "click", "3"],
@@ -286,6 +312,43 @@ fn viewer_iterates_waits_for_right_clicks_picks_and_saves() {
         // The rest of the room brightens but stays a room: a wall corner is not white.
         assert!(patch_mean(after, 4, 4) < 250.0);
     }
+
+    // A drag shows previews while the pointer moves, then accumulates again.
+    let mut drag = vec![
+        "mousemove",
+        "--window",
+        &window,
+        "20",
+        "20",
+        "mousedown",
+        "1",
+    ];
+    let steps: Vec<String> = (1..=12).map(|i| (20 + 2 * i).to_string()).collect();
+    for step in &steps {
+        drag.extend([
+            "mousemove",
+            "--window",
+            &window,
+            step,
+            "20",
+            "sleep",
+            "0.05",
+        ]);
+    }
+    drag.extend(["mouseup", "1"]);
+    x.run("xdotool", &drag);
+    let line = viewer.wait_for("preview:", 1);
+    let frames: u32 = line.split_whitespace().nth(1).unwrap().parse().unwrap();
+    assert!(frames >= 1, "{line}");
+    let size = line
+        .split_whitespace()
+        .nth(4)
+        .unwrap()
+        .trim_end_matches(',');
+    let (w, h) = size.split_once('x').unwrap();
+    let (w, h): (u32, u32) = (w.parse().unwrap(), h.parse().unwrap());
+    assert!((1..=64).contains(&w) && (1..=64).contains(&h), "{line}");
+    viewer.wait_for("iter 1 finished", 3);
 
     // `Esc` quits cleanly.
     x.run("xdotool", &["key", "Escape"]);

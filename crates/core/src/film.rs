@@ -17,20 +17,9 @@ pub struct Film {
 }
 
 impl Film {
-    /// The mean of per-pixel sums (the CPU backend's, in f64) of `spp` samples each, where
-    /// rows `0 .. rows_ahead` (a pass in progress) hold one sample more.
-    pub fn from_sums(
-        width: u32,
-        height: u32,
-        spp: u32,
-        rows_ahead: u32,
-        sums: &[[f64; 3]],
-    ) -> Self {
-        Self::from_pixel_sums(width, height, spp, rows_ahead, sums.iter().copied())
-    }
-
-    /// The mean of the GPU's fixed-point sums ([`GpuAccumPixel`]) of `spp` samples per
-    /// pixel, where rows `0 .. rows_ahead` (a frame in progress) hold one sample more.
+    /// The mean of fixed-point sums ([`GpuAccumPixel`], both backends accumulate them) of
+    /// `spp` samples per pixel, where rows `0 .. rows_ahead` (a pass in progress) hold one
+    /// sample more.
     pub fn from_fixed_point(
         width: u32,
         height: u32,
@@ -38,25 +27,13 @@ impl Film {
         rows_ahead: u32,
         sums: &[GpuAccumPixel],
     ) -> Self {
-        let sums = sums.iter().map(|a| [0, 1, 2].map(|c| a.channel_sum(c)));
-        Self::from_pixel_sums(width, height, spp, rows_ahead, sums)
-    }
-
-    /// Divides each row-major pixel sum by its sample count: `spp`, one more in rows
-    /// `0 .. rows_ahead`.
-    fn from_pixel_sums(
-        width: u32,
-        height: u32,
-        spp: u32,
-        rows_ahead: u32,
-        sums: impl Iterator<Item = [f64; 3]>,
-    ) -> Self {
         let pixels = sums
+            .iter()
             .enumerate()
             .map(|(i, sum)| {
                 let ahead = (i / width as usize) < rows_ahead as usize;
                 let scale = 1.0 / f64::from((spp + u32::from(ahead)).max(1));
-                sum.map(|c| (c * scale) as f32)
+                [0, 1, 2].map(|c| (sum.channel_sum(c) * scale) as f32)
             })
             .collect();
         Self {

@@ -268,7 +268,7 @@ const _: () = assert!(size_of::<GpuRenderParams>() == 128);
 /// `hi + lo / 2^32`, added with integer carries on the GPU, so it is exact and merges
 /// exactly; the fourth lane is unused.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuAccumPixel {
     /// Integer part of the sum.
     pub hi: [u32; 4],

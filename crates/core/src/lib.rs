@@ -15,6 +15,7 @@ pub mod prepared;
 pub mod renderer;
 pub mod shading;
 pub mod textures;
+pub mod tonemap;
 
 pub use error::{GeometryError, RenderError};
 pub use film::Film;
@@ -23,3 +24,4 @@ pub use prepared::PreparedScene;
 pub use renderer::Renderer;
 pub use shading::Shading;
 pub use textures::Textures;
+pub use tonemap::ToneMap;

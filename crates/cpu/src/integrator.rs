@@ -2,7 +2,7 @@
 //! `integrator.wgsl` (same loop, same order of sample dimensions).
 
 use glam::Vec3A;
-use pathlight_core::gpu_types::{GpuRenderParams, NO_LIGHT};
+use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams, NO_LIGHT};
 
 use crate::bsdf::{eval_bsdf, has_continuous_lobe, sample_bsdf};
 use crate::bvh::{Hit, Tracer};
@@ -259,5 +259,37 @@ pub fn accumulated_value(radiance: Vec3A) -> Vec3A {
         radiance.clamp(Vec3A::ZERO, Vec3A::splat(SAMPLE_MAX))
     } else {
         Vec3A::ZERO
+    }
+}
+
+/// `acc += value` in the accumulation's 64-bit fixed point, `value` clamped to
+/// [0, SAMPLE_MAX]: the sums are the GPU's bit for bit, whatever order samples arrive in.
+/// Twin of WGSL `add_sample`.
+#[inline(always)]
+pub fn add_sample(acc: &mut GpuAccumPixel, value: Vec3A) {
+    let v = value.clamp(Vec3A::ZERO, Vec3A::splat(SAMPLE_MAX));
+    let whole = v.floor();
+    // frac * 2^32 is exact: frac has 24 significant bits and the scale is a power of two.
+    let frac = (v - whole) * 4_294_967_296.0;
+    let sample = GpuAccumPixel {
+        hi: [whole.x as u32, whole.y as u32, whole.z as u32, 0],
+        lo: [frac.x as u32, frac.y as u32, frac.z as u32, 0],
+    };
+    add_fixed(acc, &sample);
+}
+
+/// `acc += x` on 64-bit fixed point, saturating instead of wrapping. Twin of WGSL
+/// `add_fixed`.
+#[inline(always)]
+pub fn add_fixed(acc: &mut GpuAccumPixel, x: &GpuAccumPixel) {
+    for c in 0..4 {
+        let (lo, carry) = acc.lo[c].overflowing_add(x.lo[c]);
+        let (hi, wrapped) = acc.hi[c].overflowing_add(x.hi[c]);
+        let (hi, carried_over) = hi.overflowing_add(u32::from(carry));
+        (acc.hi[c], acc.lo[c]) = if wrapped || carried_over {
+            (u32::MAX, u32::MAX)
+        } else {
+            (hi, lo)
+        };
     }
 }

@@ -8,6 +8,7 @@ pub mod bsdf;
 pub mod bvh;
 pub mod camera;
 pub mod cpu_scene;
+pub mod display;
 pub mod integrator;
 pub mod intersect;
 pub mod lights;
@@ -20,7 +21,7 @@ pub mod surface;
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
-use pathlight_core::gpu_types::GpuRenderParams;
+use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams};
 use pathlight_core::{Film, PreparedScene, RenderError, Renderer, Shading};
 use pathlight_scene::{Camera, RenderSettings};
 use rayon::prelude::*;
@@ -32,18 +33,20 @@ use crate::row::{RowJob, Tally, render_row_with};
 
 /// Aimed-for duration of one `advance` (for progress reports and interruption).
 const TARGET_BATCH: Duration = Duration::from_millis(250);
+/// Most samples per pixel one `advance` renders.
+const MAX_BATCH_SAMPLES: u32 = 1024;
 
 /// A progressive render on the CPU.
 #[derive(Debug)]
 pub struct CpuRenderer {
     scene: PreparedScene,
     params: GpuRenderParams,
-    /// Per pixel, the sum of accumulated samples (f64: exact enough for any sample count).
-    sums: Vec<[f64; 3]>,
+    /// Per pixel, the sum of accumulated samples in the GPU's fixed point (exact, and the
+    /// same whatever order they were added in).
+    sums: Vec<GpuAccumPixel>,
     samples_done: u32,
-    batch_samples: u32,
-    /// Rows per `advance` while one pass takes longer than [`TARGET_BATCH`] (else the height).
-    band_rows: u32,
+    /// Seconds one sample of one pixel took in the last render (`None` before the first).
+    pixel_seconds: Option<f64>,
     /// Rows of the pass in progress that already hold its sample.
     rows_ahead: u32,
     /// Rays traced and samples dropped as not finite, since the last restart.
@@ -54,11 +57,12 @@ pub struct CpuRenderer {
 
 /// The CPU backend running `isa`, as reports name it (`cpu backend, 2 threads, x86-64-v3`).
 pub fn describe(isa: InstructionSet) -> String {
-    format!(
-        "cpu backend, {} threads, {}",
-        rayon::current_num_threads(),
-        isa.name()
-    )
+    format!("cpu backend, {}", threads_and_level(isa))
+}
+
+/// The threads it renders on and the compiled level it runs (`2 threads, x86-64-v3`).
+pub fn threads_and_level(isa: InstructionSet) -> String {
+    format!("{} threads, {}", rayon::current_num_threads(), isa.name())
 }
 
 /// A level of the path tracer this CPU cannot run.
@@ -74,10 +78,9 @@ impl CpuRenderer {
         Self {
             scene: scene.clone(),
             params,
-            sums: vec![[0.0; 3]; pixels],
+            sums: vec![GpuAccumPixel::default(); pixels],
             samples_done: 0,
-            batch_samples: 1,
-            band_rows: params.height,
+            pixel_seconds: None,
             rows_ahead: 0,
             tally: Tally::default(),
             isa: InstructionSet::best(),
@@ -103,7 +106,8 @@ impl CpuRenderer {
         let (params, isa, offset) = (&self.params, self.isa, self.samples_done);
         let width = params.width as usize;
         let pixels = rows.start as usize * width..rows.end as usize * width;
-        let tally = self.sums[pixels]
+        let started = Instant::now();
+        let tally = self.sums[pixels.clone()]
             .par_chunks_mut(width)
             .enumerate()
             .map_init(
@@ -120,24 +124,45 @@ impl CpuRenderer {
             )
             .sum::<Tally>();
         self.tally = self.tally + tally;
+        let pixel_samples = (pixels.len() as f64 * f64::from(samples)).max(1.0);
+        self.pixel_seconds = Some(started.elapsed().as_secs_f64() / pixel_samples);
     }
 
-    /// Renders the next band of rows of the pass in progress; returns whether it completed
-    /// the pass. Bands are sized to take about [`TARGET_BATCH`].
-    fn render_band(&mut self) -> bool {
+    /// Renders the next `rows` rows (fewer at the end) of the pass in progress; returns
+    /// whether they completed the pass.
+    fn render_band(&mut self, rows: u32) -> bool {
         let height = self.params.height;
-        let rows = self.band_rows.min(height - self.rows_ahead);
-        let started = Instant::now();
-        self.render(self.rows_ahead..self.rows_ahead + rows, 1);
-        let per_row = started.elapsed().as_secs_f64() / f64::from(rows);
-        self.band_rows = ((TARGET_BATCH.as_secs_f64() / per_row.max(1e-9)) as u32).clamp(1, height);
-        self.rows_ahead += rows;
-        if self.rows_ahead < height {
+        let end = (self.rows_ahead + rows.max(1)).min(height);
+        self.render(self.rows_ahead..end, 1);
+        self.rows_ahead = end;
+        if end < height {
             return false;
         }
         self.rows_ahead = 0;
         self.samples_done += 1;
         true
+    }
+
+    /// Rows of one sample that take about `target` at the last render's speed (the whole
+    /// image before the first).
+    fn rows_for(&self, target: Duration) -> u32 {
+        let (width, height) = (self.params.width, self.params.height);
+        self.pixel_seconds.map_or(height, |seconds| {
+            let row_seconds = seconds * f64::from(width);
+            ((target.as_secs_f64() / row_seconds.max(1e-12)) as u32).clamp(1, height)
+        })
+    }
+
+    /// The running sums, one per pixel, row by row, in the GPU's fixed point
+    /// (`AccumPixel`): rows `0 .. rows_ahead()` hold `samples_done() + 1` samples, the
+    /// others `samples_done()`.
+    pub fn accumulation(&self) -> &[GpuAccumPixel] {
+        &self.sums
+    }
+
+    /// Rows of the pass in progress that already hold its sample.
+    pub fn rows_ahead(&self) -> u32 {
+        self.rows_ahead
     }
 }
 
@@ -152,7 +177,7 @@ impl Renderer for CpuRenderer {
 
     fn set_camera(&mut self, camera: &Camera) -> Result<(), RenderError> {
         self.params.set_camera(camera);
-        self.sums = vec![[0.0; 3]; (camera.width * camera.height) as usize];
+        self.sums = vec![GpuAccumPixel::default(); (camera.width * camera.height) as usize];
         self.restart();
         Ok(())
     }
@@ -165,44 +190,45 @@ impl Renderer for CpuRenderer {
     }
 
     fn restart(&mut self) {
-        self.sums.fill([0.0; 3]);
+        self.sums.fill(GpuAccumPixel::default());
         self.samples_done = 0;
         self.rows_ahead = 0;
         self.tally = Tally::default();
     }
 
     /// Twin of the GPU renderer's `advance`: the same samples of the same pixels give the
-    /// same estimator. A batch is sized to take about `TARGET_BATCH`.
+    /// same estimator. A batch is sized to take about `TARGET_BATCH`; a pass that takes
+    /// longer is rendered in bands of rows, so that an interrupt waits a fraction of a second.
     fn advance(&mut self, max_samples: u32) -> Result<u32, RenderError> {
-        let samples = self.batch_samples.min(max_samples);
-        if samples == 0 {
+        if max_samples == 0 {
             return Ok(0);
         }
-        if self.rows_ahead > 0 || self.band_rows < self.params.height {
-            return Ok(u32::from(self.render_band()));
+        let pixels = f64::from(self.params.width) * f64::from(self.params.height);
+        let pass = self.pixel_seconds.map(|s| s * pixels);
+        let target = TARGET_BATCH.as_secs_f64();
+        if self.rows_ahead > 0 || pass.is_some_and(|p| p > target) {
+            let rows = self.rows_for(TARGET_BATCH);
+            return Ok(u32::from(self.render_band(rows)));
         }
-        let started = Instant::now();
+        let samples = pass
+            .map_or(1, |p| {
+                ((target / p.max(1e-12)) as u32).clamp(1, MAX_BATCH_SAMPLES)
+            })
+            .min(max_samples);
         self.render(0..self.params.height, samples);
         self.samples_done += samples;
-        let per_sample = started.elapsed().as_secs_f64() / f64::from(samples);
-        let per_target = TARGET_BATCH.as_secs_f64() / per_sample.max(1e-9);
-        self.batch_samples = (per_target as u32).clamp(1, 1024);
-        // A pass longer than the target: bands of rows from now on, so that an interrupt
-        // waits for a fraction of a second.
-        self.band_rows =
-            ((f64::from(self.params.height) * per_target) as u32).clamp(1, self.params.height);
         Ok(samples)
     }
 
-    /// A whole frame at once: rows are spread over every core.
-    fn step_frame(&mut self, _target: Duration) -> Result<bool, RenderError> {
-        self.queue_frame()?;
-        Ok(true)
+    /// Renders bands of rows of the current pass, spread over every core, for about `target`.
+    fn step_frame(&mut self, target: Duration) -> Result<bool, RenderError> {
+        let rows = self.rows_for(target);
+        Ok(self.render_band(rows))
     }
 
+    /// The rest of the pass in progress, or a whole one, at once.
     fn queue_frame(&mut self) -> Result<(), RenderError> {
-        self.render(0..self.params.height, 1);
-        self.samples_done += 1;
+        self.render_band(self.params.height);
         Ok(())
     }
 
@@ -224,7 +250,7 @@ impl Renderer for CpuRenderer {
 
     fn film(&self) -> Result<Film, RenderError> {
         let (width, height) = self.size();
-        Ok(Film::from_sums(
+        Ok(Film::from_fixed_point(
             width,
             height,
             self.samples_done,
@@ -259,18 +285,16 @@ mod tests {
         let (one, two) = (whole(1), whole(2));
         let mut banded = CpuRenderer::new(&prepared, &scene.camera, &scene.settings);
         banded.advance(1).unwrap();
-        banded.band_rows = 4;
         // Bands of 4, 4 and 2 rows complete the second pass.
-        assert_eq!(banded.advance(1).unwrap(), 0);
+        assert!(!banded.render_band(4));
         assert_eq!(banded.rows_ahead, 4);
         let mid = banded.film().unwrap();
         let split = 4 * 12;
         assert_eq!(mid.pixels[..split], two.pixels[..split], "rows ahead");
         assert_eq!(mid.pixels[split..], one.pixels[split..], "rows behind");
-        banded.band_rows = 4;
-        assert_eq!(banded.advance(1).unwrap(), 0);
-        banded.band_rows = 4;
-        assert_eq!(banded.advance(1).unwrap(), 1);
+        assert!(!banded.render_band(4));
+        assert!(banded.render_band(4));
+        assert_eq!(banded.rows_ahead, 0);
         assert_eq!(banded.film().unwrap(), two);
     }
 }

@@ -4,11 +4,11 @@
 use std::ops::Range;
 
 use glam::Vec3A;
-use pathlight_core::gpu_types::GpuRenderParams;
+use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams};
 
 use crate::bvh::Tracer;
 use crate::cpu_scene::CpuScene;
-use crate::integrator::{Path, T_MAX, accumulated_value};
+use crate::integrator::{Path, T_MAX, accumulated_value, add_sample};
 use crate::packet::{PACKET, RayPacket};
 use crate::sampler::Sampler;
 
@@ -52,7 +52,7 @@ impl std::iter::Sum for Tally {
 /// sample. The whole path tracer is inlined here, so that each [`InstructionSet`] level
 /// compiles all of it.
 #[inline(always)]
-fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> Tally {
+fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [GpuAccumPixel]) -> Tally {
     let (scene, params) = (job.scene, job.params);
     let samples_per_pixel = job.samples.len();
     let sample_count = row.len() * samples_per_pixel;
@@ -119,11 +119,8 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> Tally 
 /// Adds the sample of the ended `path` to its pixel's `sum` (a non-finite one as zero);
 /// returns its rays and whether it was dropped.
 #[inline(always)]
-fn finish(path: &Path, sum: &mut [f64; 3]) -> Tally {
-    let value = accumulated_value(path.sample.radiance);
-    for c in 0..3 {
-        sum[c] += f64::from(value[c]);
-    }
+fn finish(path: &Path, sum: &mut GpuAccumPixel) -> Tally {
+    add_sample(sum, accumulated_value(path.sample.radiance));
     Tally {
         rays: u64::from(path.sample.rays),
         dropped: u64::from(!path.sample.radiance.is_finite()),
@@ -193,7 +190,7 @@ pub(crate) fn render_row_with(
     isa: InstructionSet,
     tracer: &mut Tracer,
     job: &RowJob,
-    row: &mut [[f64; 3]],
+    row: &mut [GpuAccumPixel],
 ) -> Tally {
     match isa {
         InstructionSet::Baseline => render_row(tracer, job, row),
@@ -209,7 +206,7 @@ pub(crate) fn render_row_with(
 /// [`render_row`] for x86-64-v3.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe")]
-fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> Tally {
+fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut [GpuAccumPixel]) -> Tally {
     render_row(tracer, job, row)
 }
 
@@ -218,6 +215,10 @@ fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]])
 #[target_feature(
     enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe,avx512f,avx512vl,avx512bw,avx512dq,avx512cd,gfni"
 )]
-fn render_row_x86_64_v4_gfni(tracer: &mut Tracer, job: &RowJob, row: &mut [[f64; 3]]) -> Tally {
+fn render_row_x86_64_v4_gfni(
+    tracer: &mut Tracer,
+    job: &RowJob,
+    row: &mut [GpuAccumPixel],
+) -> Tally {
     render_row(tracer, job, row)
 }

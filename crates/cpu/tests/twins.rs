@@ -175,6 +175,7 @@ fn every_integrator_file_has_its_twin_file() {
         "bsdf",
         "lights",
         "integrator",
+        "display",
     ] {
         assert!(
             shaders().join(format!("{stem}.wgsl")).is_file(),

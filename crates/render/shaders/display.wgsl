@@ -1,7 +1,8 @@
 // The viewer's display pass: one full-screen triangle whose fragments read the linear
 // accumulation (fixed-point sums, see integrator.wgsl), divide by the sample count, apply
 // exposure and an optional tone mapper, and encode sRGB unless the surface does. The
-// accumulation itself is never changed. Host: `crates/render/src/display.rs`.
+// accumulation itself is never changed. Host: `crates/render/src/display.rs`. The CPU
+// backend's viewer runs the CPU twin, `crates/cpu/src/display.rs`.
 
 // Host: `GpuDisplayParams`.
 struct DisplayParams {
@@ -42,12 +43,14 @@ fn vertex_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
 }
 
 // Narkowicz's fit of the ACES filmic curve.
+// CPU twin: `aces`
 fn aces(x: vec3f) -> vec3f {
     return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), vec3f(0.0), vec3f(1.0));
 }
 
 // AgX (Troy Sobotka) with its default look: log2 encoding in the AgX inset space, the
 // polynomial fit of its sigmoid (Benjamin Wrensch's), back to linear Rec.709.
+// CPU twin: `agx`
 fn agx(color: vec3f) -> vec3f {
     let inset = mat3x3f(
         vec3f(0.842479062253094, 0.0423282422610123, 0.0423756549057051),
@@ -71,12 +74,14 @@ fn agx(color: vec3f) -> vec3f {
     return clamp(pow(max(outset * s, vec3f(0.0)), vec3f(2.2)), vec3f(0.0), vec3f(1.0));
 }
 
+// CPU twin: `srgb_encode`
 fn srgb_encode(c: vec3f) -> vec3f {
     let x = clamp(c, vec3f(0.0), vec3f(1.0));
     return select(1.055 * pow(x, vec3f(1.0 / 2.4)) - 0.055, 12.92 * x, x <= vec3f(0.0031308));
 }
 
 @fragment
+// CPU twin: `display_color`
 fn fragment_main(@builtin(position) position: vec4f) -> @location(0) vec4f {
     let x = min(u32(position.x * f32(display.width) / display.target_width), display.width - 1u);
     let y = min(u32(position.y * f32(display.height) / display.target_height), display.height - 1u);

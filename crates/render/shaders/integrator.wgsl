@@ -29,6 +29,7 @@ struct AccumPixel {
 const SAMPLE_MAX: f32 = 16777216.0;
 
 // `acc += value` in fixed point; `value` is clamped to [0, SAMPLE_MAX].
+// CPU twin: `add_sample`
 fn add_sample(acc: ptr<function, AccumPixel>, value: vec3f) {
     let v = clamp(value, vec3f(0.0), vec3f(SAMPLE_MAX));
     let whole = floor(v);
@@ -39,6 +40,7 @@ fn add_sample(acc: ptr<function, AccumPixel>, value: vec3f) {
 }
 
 // `acc += x` on 64-bit fixed point, saturating instead of wrapping.
+// CPU twin: `add_fixed`
 fn add_fixed(acc: ptr<function, AccumPixel>, x: AccumPixel) {
     let lo = (*acc).lo + x.lo;
     let carry = select(vec4u(0u), vec4u(1u), lo < x.lo);

@@ -39,6 +39,37 @@ fn rank(info: &AdapterInfo) -> (u8, u8) {
     (kind, backend)
 }
 
+/// Whether an adapter is a hardware GPU (discrete, integrated, virtual, or a kind its driver
+/// does not name) rather than a software rasteriser (`DeviceType::Cpu`: lavapipe, llvmpipe,
+/// SwiftShader, WARP), which runs the WGSL far slower than the native CPU backend.
+pub fn is_hardware(info: &AdapterInfo) -> bool {
+    info.device_type != DeviceType::Cpu
+}
+
+/// What `--backend auto` runs on, given the adapters found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AutoChoice {
+    /// The WGSL on the hardware GPU at this index: the best-ranked one.
+    Gpu(usize),
+    /// The native CPU backend, as there is no hardware GPU; the index is the software
+    /// adapter `--backend gpu` would run on, if there is one.
+    Cpu(Option<usize>),
+}
+
+/// The `--backend auto` choice among `adapters`: the best hardware GPU, else the CPU
+/// backend.
+pub fn auto_choice(adapters: &[AdapterInfo]) -> AutoChoice {
+    let best = |hardware: bool| {
+        (0..adapters.len())
+            .filter(|&i| is_hardware(&adapters[i]) == hardware)
+            .min_by_key(|&i| rank(&adapters[i]))
+    };
+    match best(true) {
+        Some(gpu) => AutoChoice::Gpu(gpu),
+        None => AutoChoice::Cpu(best(false)),
+    }
+}
+
 /// One line naming an adapter, as printed by the CLI.
 pub fn describe(info: &AdapterInfo) -> String {
     format!(
@@ -178,5 +209,54 @@ impl GpuContext {
             adapter: adapter.clone(),
             adapter_info,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn adapter(device_type: DeviceType, backend: Backend) -> AdapterInfo {
+        AdapterInfo::new(device_type, backend)
+    }
+
+    #[test]
+    fn auto_takes_the_best_hardware_gpu_and_the_cpu_backend_over_software_ones() {
+        let lavapipe = adapter(DeviceType::Cpu, Backend::Vulkan);
+        let llvmpipe = adapter(DeviceType::Cpu, Backend::Gl);
+        let integrated_gl = adapter(DeviceType::IntegratedGpu, Backend::Gl);
+        let integrated = adapter(DeviceType::IntegratedGpu, Backend::Vulkan);
+        let discrete = adapter(DeviceType::DiscreteGpu, Backend::Vulkan);
+        let virtual_gpu = adapter(DeviceType::VirtualGpu, Backend::Vulkan);
+        let unnamed = adapter(DeviceType::Other, Backend::Gl);
+
+        // Hardware of any kind wins over software; among hardware, the usual ranking.
+        let cases = [
+            (
+                vec![lavapipe.clone(), integrated_gl.clone(), integrated.clone()],
+                AutoChoice::Gpu(2),
+            ),
+            (
+                vec![integrated.clone(), lavapipe.clone(), discrete.clone()],
+                AutoChoice::Gpu(2),
+            ),
+            (vec![lavapipe.clone(), virtual_gpu], AutoChoice::Gpu(1)),
+            (vec![lavapipe.clone(), unnamed], AutoChoice::Gpu(1)),
+            // Software only: the CPU backend, naming the adapter `--backend gpu` would take.
+            (
+                vec![llvmpipe.clone(), lavapipe.clone()],
+                AutoChoice::Cpu(Some(1)),
+            ),
+            (vec![llvmpipe], AutoChoice::Cpu(Some(0))),
+            // None at all.
+            (vec![], AutoChoice::Cpu(None)),
+        ];
+        for (adapters, expected) in cases {
+            let kinds: Vec<_> = adapters
+                .iter()
+                .map(|a| (a.device_type, a.backend))
+                .collect();
+            assert_eq!(auto_choice(&adapters), expected, "{kinds:?}");
+        }
     }
 }

@@ -1,51 +1,12 @@
 //! The viewer's display pass (`shaders/display.wgsl`): shows the linear accumulation on a
 //! surface through the sRGB curve and an optional tone mapper, leaving it unchanged.
 
-use pathlight_core::{RenderError, Renderer};
+use pathlight_core::{RenderError, Renderer, ToneMap};
 
+use crate::GpuContext;
 use crate::gpu_renderer::GpuRenderer;
 use crate::pipeline::bind_buffers;
 use crate::wgsl;
-
-/// How radiance is mapped to the display's [0, 1].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum ToneMap {
-    /// Clamped: what `pathlight render` writes to PNG.
-    #[default]
-    Clamp,
-    /// The ACES filmic curve (Narkowicz's fit).
-    Aces,
-    /// AgX with its default look.
-    Agx,
-}
-
-impl ToneMap {
-    /// The next tone mapper in the cycle (the viewer's `T` key).
-    pub fn next(self) -> Self {
-        match self {
-            ToneMap::Clamp => ToneMap::Aces,
-            ToneMap::Aces => ToneMap::Agx,
-            ToneMap::Agx => ToneMap::Clamp,
-        }
-    }
-
-    /// Its name, for messages and the title.
-    pub fn name(self) -> &'static str {
-        match self {
-            ToneMap::Clamp => "clamp",
-            ToneMap::Aces => "ACES",
-            ToneMap::Agx => "AgX",
-        }
-    }
-
-    fn shader_value(self) -> u32 {
-        match self {
-            ToneMap::Clamp => 0,
-            ToneMap::Aces => 1,
-            ToneMap::Agx => 2,
-        }
-    }
-}
 
 /// Parameters of the display pass (a read-only storage buffer). WGSL: `DisplayParams`.
 #[repr(C)]
@@ -69,6 +30,36 @@ pub struct GpuDisplayParams {
     pub encode_srgb: u32,
 }
 const _: () = assert!(size_of::<GpuDisplayParams>() == 32);
+
+/// An image to display: running sums in the accumulation's fixed point (`AccumPixel`,
+/// [`pathlight_core::gpu_types::GpuAccumPixel`] on the host), on the presenting device.
+#[derive(Debug, Clone, Copy)]
+pub struct DisplaySource<'a> {
+    /// The sums, row by row.
+    pub pixels: &'a wgpu::Buffer,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel in rows `rows_ahead ..`.
+    pub samples: u32,
+    /// Rows holding one sample more (a pass in progress).
+    pub rows_ahead: u32,
+}
+
+impl<'a> DisplaySource<'a> {
+    /// The image of a GPU renderer, on its device.
+    pub fn of(renderer: &'a GpuRenderer) -> Self {
+        let (width, height) = renderer.size();
+        Self {
+            pixels: renderer.accumulation(),
+            width,
+            height,
+            samples: renderer.samples_done(),
+            rows_ahead: renderer.rows_ahead(),
+        }
+    }
+}
 
 /// The display pipeline for one surface format.
 #[derive(Debug)]
@@ -157,24 +148,23 @@ impl DisplayPass {
         })
     }
 
-    /// Draws `renderer`'s current image, scaled to fill `target` (`target_size` pixels).
+    /// Draws `source` (on `ctx`'s device), scaled to fill `target` (`target_size` pixels).
     pub fn draw(
         &self,
-        renderer: &GpuRenderer,
+        ctx: &GpuContext,
+        source: DisplaySource,
         target: &wgpu::TextureView,
         target_size: (u32, u32),
         tonemap: ToneMap,
     ) {
-        let ctx = renderer.context();
-        let (width, height) = renderer.size();
         let params = GpuDisplayParams {
-            width,
-            height,
-            samples: renderer.samples_done(),
-            rows_ahead: renderer.rows_ahead(),
+            width: source.width,
+            height: source.height,
+            samples: source.samples,
+            rows_ahead: source.rows_ahead,
             target_width: target_size.0.max(1) as f32,
             target_height: target_size.1.max(1) as f32,
-            tonemap: tonemap.shader_value(),
+            tonemap: tonemap as u32,
             encode_srgb: u32::from(self.encode_srgb),
         };
         ctx.queue
@@ -183,7 +173,7 @@ impl DisplayPass {
             &ctx.device,
             "display",
             &self.layout,
-            &[&self.params_buffer, renderer.accumulation()],
+            &[&self.params_buffer, source.pixels],
         );
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
         {

@@ -59,6 +59,14 @@ impl Iterations {
         (self.current, self.iters)
     }
 
+    /// Frames the current iteration still lacks (none unless it is running).
+    pub fn frames_left(&self) -> u32 {
+        match self.phase {
+            Phase::Running => self.frames_per_iter - self.frames_in_current,
+            _ => 0,
+        }
+    }
+
     /// Average frames per second of the current iteration so far (0 before its first frame).
     pub fn fps(&self) -> f64 {
         if self.time_in_current.is_zero() {

@@ -4,8 +4,10 @@
 //! zoom. See README.md for every button and key.
 //!
 //! The window ([`window`]) turns events into actions ([`input`]); the viewer applies them
-//! through the backend interface: a camera move or a resize sets only the camera, a light
-//! toggle only the materials.
+//! through the backend interface ([`frames`]): a camera move or a resize sets only the
+//! camera, at preview size while it keeps moving ([`preview`]), a light toggle only the
+//! materials. The GPU backend renders in the event loop; the CPU backend on a thread of its
+//! own ([`cpu_frames`]), which wakes the loop with [`FrameReady`].
 
 /// A line on standard output that never fails (the tests read these lines).
 macro_rules! say {
@@ -18,9 +20,12 @@ macro_rules! say {
 }
 
 mod camera;
+mod cpu_frames;
+mod frames;
 mod input;
 mod iterations;
 mod picking;
+mod preview;
 mod title;
 mod window;
 
@@ -28,27 +33,31 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context as _, anyhow};
-use pathlight_core::PreparedScene;
-use pathlight_render::display::ToneMap;
-use pathlight_scene::Scene;
+use pathlight_core::{PreparedScene, ToneMap};
+use pathlight_scene::{Camera, Scene};
 use winit::application::ApplicationHandler;
 use winit::dpi::{PhysicalPosition, PhysicalSize};
 use winit::event::WindowEvent;
-use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
 use winit::window::WindowId;
 
 use crate::backend::load_scene;
-use crate::cli::ViewArgs;
+use crate::cli::{DeviceArgs, ViewArgs};
 use crate::output;
 use camera::Orbit;
 use input::{Action, Pointer, key_action, wheel_action};
 use iterations::{Iterations, Phase};
 use picking::{LightSwitch, pick};
+use preview::Preview;
 use title::{RayRate, Title};
 use window::ViewerWindow;
 
 /// Longest time spent rendering between two presented images (a submission may overrun it).
 const PRESENT_INTERVAL: Duration = Duration::from_millis(33);
+
+/// The event the CPU backend's thread sends when it has rendered a band of rows.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameReady;
 
 /// Whether a display server is reachable, as far as the environment tells (Unix without
 /// macOS); elsewhere the window system answers.
@@ -76,13 +85,13 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         return Err(no_display());
     }
     let scene = load_scene(&args.scene)?;
-    let event_loop = EventLoop::new().map_err(|err| {
+    let event_loop = EventLoop::with_user_event().build().map_err(|err| {
         anyhow!(
             "cannot open a window ({err}). Render headless instead: \
              `pathlight render [SCENE] -o image.png`"
         )
     })?;
-    let mut viewer = Viewer::new(scene, args)?;
+    let mut viewer = Viewer::new(scene, args, event_loop.create_proxy())?;
     event_loop
         .run_app(&mut viewer)
         .context("the window system failed")?;
@@ -100,7 +109,12 @@ struct Viewer {
     iterations: Iterations,
     tonemap: ToneMap,
     paused: bool,
-    adapter_name: Option<String>,
+    /// Previews while the camera moves.
+    preview: Preview,
+    /// Size of the frames the renderer renders now (the preview's while moving).
+    rendering: (u32, u32),
+    device: DeviceArgs,
+    proxy: EventLoopProxy<FrameReady>,
     save_dir: PathBuf,
     pointer: Pointer,
     rays: RayRate,
@@ -109,8 +123,14 @@ struct Viewer {
 }
 
 impl Viewer {
-    fn new(scene: Scene, args: &ViewArgs) -> anyhow::Result<Self> {
+    fn new(
+        scene: Scene,
+        args: &ViewArgs,
+        proxy: EventLoopProxy<FrameReady>,
+    ) -> anyhow::Result<Self> {
         Ok(Self {
+            preview: Preview::new(),
+            rendering: (scene.camera.width, scene.camera.height),
             prepared: PreparedScene::new(&scene)?,
             orbit: Orbit::from_camera(&scene.camera),
             lights: LightSwitch::new(&scene, args.light_strength),
@@ -118,7 +138,8 @@ impl Viewer {
             scene,
             tonemap: ToneMap::default(),
             paused: false,
-            adapter_name: args.adapter.clone(),
+            device: args.device.clone(),
+            proxy,
             save_dir: args.save_dir.clone(),
             pointer: Pointer::default(),
             rays: RayRate::new(),
@@ -142,60 +163,97 @@ impl Viewer {
         }
     }
 
-    /// Gives the renderer the camera as the orbit (and the window size) has it now.
+    /// The camera moved (orbit, pan, zoom) or the window was resized: the renderer renders
+    /// previews of the camera as the orbit and the window size have it now.
     fn camera_changed(&mut self) -> anyhow::Result<()> {
         self.orbit.apply(&mut self.scene.camera);
+        let camera = self.preview.moved(Instant::now(), &self.scene.camera);
+        self.set_camera(&camera, true)
+    }
+
+    /// Gives the renderer `camera` (a preview's or not) and starts the image over.
+    fn set_camera(&mut self, camera: &Camera, preview: bool) -> anyhow::Result<()> {
         if let Some(window) = &mut self.window {
-            window.renderer().set_camera(&self.scene.camera)?;
+            window.frames.set_camera(camera, preview)?;
         }
+        self.rendering = (camera.width, camera.height);
         self.restarted();
         Ok(())
     }
 
-    fn wants_frames(&self) -> bool {
-        !self.paused && self.iterations.phase() == Phase::Running
+    /// When the pointer has rested, reports the previews and starts accumulating at full
+    /// size.
+    fn settle(&mut self, now: Instant) -> anyhow::Result<()> {
+        if let Some(run) = self.preview.rested(now) {
+            say!(
+                "preview: {} frames at {}x{}, {:.1} fps",
+                run.frames,
+                run.width,
+                run.height,
+                run.fps
+            );
+            self.set_camera(&self.scene.camera.clone(), false)?;
+        }
+        Ok(())
     }
 
-    /// Renders for up to [`PRESENT_INTERVAL`], then shows the image.
+    fn wants_frames(&self) -> bool {
+        !self.paused && (self.preview.is_moving() || self.iterations.phase() == Phase::Running)
+    }
+
+    /// Frames the renderer should render next: as many as the iteration lacks, or previews
+    /// until the pointer rests.
+    fn frames_wanted(&self) -> u32 {
+        match (self.paused, self.preview.is_moving()) {
+            (true, _) => 0,
+            (false, true) => u32::MAX,
+            (false, false) => self.iterations.frames_left(),
+        }
+    }
+
+    /// Renders for up to [`PRESENT_INTERVAL`] (or collects what the CPU backend's thread
+    /// rendered), counts the frames finished, then shows the image.
     fn redraw(&mut self) -> anyhow::Result<()> {
-        let rendering = self.wants_frames();
+        let now = Instant::now();
+        self.settle(now)?;
+        let wanted = self.frames_wanted();
         let Some(window) = &mut self.window else {
             return Ok(());
         };
-        if rendering {
-            let started = Instant::now();
-            let target = window.submission_target;
-            while started.elapsed() < PRESENT_INTERVAL {
-                let piece = Instant::now();
-                let frame_done = window.renderer().step_frame(target)?;
-                self.iterations.add_time(piece.elapsed());
-                if !frame_done {
+        let rendered = window.frames.render(wanted, PRESENT_INTERVAL)?;
+        let pixels = u64::from(self.rendering.0) * u64::from(self.rendering.1);
+        let moving = self.preview.is_moving();
+        self.preview
+            .timed(rendered.frames, rendered.time, pixels, Instant::now());
+        if !moving {
+            self.iterations.add_time(rendered.time);
+            for _ in 0..rendered.frames {
+                let Some(finished) = self.iterations.frame_done() else {
                     continue;
-                }
-                if let Some(finished) = self.iterations.frame_done() {
-                    say!(
-                        "iter {} finished, {:.2} fps",
-                        finished.iteration,
-                        finished.fps
-                    );
-                    match self.iterations.phase() {
-                        Phase::Waiting => {
-                            say!("right-click for iteration {}", finished.iteration + 1)
-                        }
-                        _ => say!("all {} iterations finished", finished.iteration),
+                };
+                say!(
+                    "iter {} finished, {:.2} fps",
+                    finished.iteration,
+                    finished.fps
+                );
+                match self.iterations.phase() {
+                    Phase::Waiting => {
+                        say!("right-click for iteration {}", finished.iteration + 1)
                     }
-                    break;
+                    _ => say!("all {} iterations finished", finished.iteration),
                 }
             }
         }
         window.present(self.tonemap);
-        self.rays.update(window.renderer())?;
+        let frames = &window.frames;
+        self.rays.update(|| frames.rays_traced())?;
         let title = Title {
-            spp: window.renderer().samples_done(),
+            spp: frames.samples_done(),
             iterations: &self.iterations,
             paused: self.paused,
+            moving,
             rays: &self.rays,
-            device: &window.adapter,
+            device: &frames.device(),
             tonemap: self.tonemap,
         }
         .to_string();
@@ -208,7 +266,7 @@ impl Viewer {
         let Some(window) = &mut self.window else {
             return Ok(());
         };
-        let film = window.renderer().film()?;
+        let film = window.frames.film()?;
         if film.spp == 0 {
             say!("nothing to save yet: no frame finished");
             return Ok(());
@@ -252,7 +310,7 @@ impl Viewer {
             if on { "on" } else { "off" }
         );
         self.prepared.shading = self.prepared.shading_of(&self.scene);
-        window.renderer().set_materials(&self.prepared.shading)?;
+        window.frames.set_materials(&self.prepared.shading)?;
         self.restarted();
         Ok(())
     }
@@ -268,7 +326,7 @@ impl Viewer {
             Action::Restart => {
                 say!("restarted");
                 if let Some(window) = &mut self.window {
-                    window.renderer().restart();
+                    window.frames.restart();
                 }
                 self.restarted();
             }
@@ -348,20 +406,21 @@ impl Viewer {
     }
 }
 
-impl ApplicationHandler for Viewer {
+impl ApplicationHandler<FrameReady> for Viewer {
     fn resumed(&mut self, event_loop: &ActiveEventLoop) {
         if self.window.is_some() {
             return;
         }
-        let adapter = self.adapter_name.clone();
         match ViewerWindow::open(
             event_loop,
-            adapter.as_deref(),
+            &self.device,
+            self.proxy.clone(),
             &mut self.scene,
             &self.prepared,
         ) {
             Ok(window) => {
                 window.window.request_redraw();
+                self.rendering = (self.scene.camera.width, self.scene.camera.height);
                 self.window = Some(window);
             }
             Err(err) => self.fail(event_loop, err),
@@ -374,11 +433,22 @@ impl ApplicationHandler for Viewer {
         }
     }
 
+    fn user_event(&mut self, _event_loop: &ActiveEventLoop, _event: FrameReady) {
+        if let Some(window) = &self.window {
+            window.window.request_redraw();
+        }
+    }
+
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        event_loop.set_control_flow(ControlFlow::Wait);
-        if self.wants_frames()
-            && let Some(window) = &self.window
-        {
+        let Some(window) = &self.window else {
+            return;
+        };
+        // Wake when the pointer will count as resting, to start accumulating.
+        let rest = self.preview.rest_at();
+        event_loop.set_control_flow(rest.map_or(ControlFlow::Wait, ControlFlow::WaitUntil));
+        let rested = rest.is_some_and(|at| Instant::now() >= at);
+        // The GPU backend renders in the loop; the CPU backend's thread wakes it.
+        if rested || (self.wants_frames() && window.frames.polled()) {
             window.window.request_redraw();
         }
     }

@@ -3,8 +3,7 @@
 
 use std::time::{Duration, Instant};
 
-use pathlight_core::Renderer;
-use pathlight_render::display::ToneMap;
+use pathlight_core::ToneMap;
 
 use crate::view::iterations::{Iterations, Phase};
 
@@ -34,11 +33,15 @@ impl RayRate {
         self.rays_at_start = 0;
     }
 
-    /// Measures again when an interval has passed since the last measurement.
-    pub fn update(&mut self, renderer: &dyn Renderer) -> anyhow::Result<()> {
+    /// Measures again, counting the rays with `rays_traced`, when an interval has passed
+    /// since the last measurement.
+    pub fn update(
+        &mut self,
+        rays_traced: impl FnOnce() -> anyhow::Result<u64>,
+    ) -> anyhow::Result<()> {
         let elapsed = self.since.elapsed();
         if elapsed >= INTERVAL {
-            let rays = renderer.rays_traced()?;
+            let rays = rays_traced()?;
             self.per_second =
                 rays.saturating_sub(self.rays_at_start) as f64 / elapsed.as_secs_f64();
             self.since = Instant::now();
@@ -56,6 +59,8 @@ pub struct Title<'a> {
     pub iterations: &'a Iterations,
     /// Whether rendering is paused.
     pub paused: bool,
+    /// Whether the camera is moving (previews).
+    pub moving: bool,
     /// Rays per second.
     pub rays: &'a RayRate,
     /// Where it renders.
@@ -69,6 +74,7 @@ impl std::fmt::Display for Title<'_> {
         let (iteration, iters) = self.iterations.position();
         let state = match (self.paused, self.iterations.phase()) {
             (true, _) => " | paused (Space)".to_string(),
+            _ if self.moving => " | preview".to_string(),
             (false, Phase::Waiting) => format!(" | right-click for iteration {}", iteration + 1),
             (false, Phase::Done) => " | done".to_string(),
             (false, Phase::Running) => String::new(),

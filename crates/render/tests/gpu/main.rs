@@ -1,6 +1,7 @@
 //! GPU tests on a real wgpu adapter (lavapipe on CI), one binary sharing one device.
 
 mod common;
+mod display;
 mod extreme;
 mod furnace;
 mod render;
