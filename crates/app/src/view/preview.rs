@@ -39,6 +39,8 @@ pub struct Preview {
     size: (u32, u32),
     /// Measured rendering seconds per pixel per sample.
     pixel_seconds: Option<f64>,
+    /// Rendering time of the frame in progress so far (a frame may take many calls).
+    pending: Duration,
 }
 
 impl Preview {
@@ -50,6 +52,7 @@ impl Preview {
             last_frame: None,
             size: (0, 0),
             pixel_seconds: None,
+            pending: Duration::ZERO,
         }
     }
 
@@ -72,6 +75,8 @@ impl Preview {
             self.last_frame = None;
         }
         self.moving = Some((first, now));
+        // The frame in progress is abandoned.
+        self.pending = Duration::ZERO;
         let divisor = self.divisor(full.width, full.height);
         let mut camera = full.clone();
         camera.width = full.width.div_ceil(divisor);
@@ -91,12 +96,15 @@ impl Preview {
         (ratio as u32).clamp(1, MAX_DIVISOR)
     }
 
-    /// Frames of `pixels` pixels each took `time` to render: the speed previews are sized
-    /// from. Preview frames (when moving) also count towards the run.
+    /// `frames` frames of `pixels` pixels each were finished after `time` more rendering:
+    /// the speed previews are sized from (time without a finished frame counts towards the
+    /// next). Preview frames (when moving) also count towards the run.
     pub fn timed(&mut self, frames: u32, time: Duration, pixels: u64, now: Instant) {
+        self.pending += time;
         if frames == 0 {
             return;
         }
+        let time = std::mem::take(&mut self.pending);
         let per_pixel = time.as_secs_f64() / (f64::from(frames) * pixels.max(1) as f64);
         self.pixel_seconds = Some(per_pixel);
         if self.moving.is_some() {
@@ -150,10 +158,14 @@ mod tests {
         // 8 full frames per second (0.125 s each): 1/4 of the pixels take 31 ms.
         preview.timed(1, Duration::from_millis(125), 250_000, t0);
         assert_eq!(preview.moved(t0, &full).width, 250);
-        // A fast GPU: full size. A slow adapter: the smallest preview.
+        // A fast GPU: full size. A slow adapter: the smallest preview, also when its frames
+        // take many calls.
         preview.timed(1, Duration::from_millis(2), 250_000, t0);
         assert_eq!(preview.moved(t0, &full).width, 500);
-        preview.timed(1, Duration::from_secs(60), 250_000, t0);
+        for _ in 0..600 {
+            preview.timed(0, Duration::from_millis(100), 250_000, t0);
+        }
+        preview.timed(1, Duration::from_millis(100), 250_000, t0);
         let smallest = preview.moved(t0, &full);
         assert_eq!(
             (smallest.width, smallest.height),
