@@ -1,8 +1,9 @@
 //! pathlight's native CPU backend: the twin of every WGSL file of the integrator, file for
 //! file (`shaders/X.wgsl` is `src/X.rs`, each function naming its WGSL twin), and of the
-//! viewer's display pass ([`display`]), over the same prepared scene, parallel over rows with rayon and compiled per instruction-set
-//! level ([`InstructionSet`]). Its rays are traced in packets ([`packet`]) through the
-//! 4-wide BVH both backends walk. The tests render scenes on both backends and compare.
+//! viewer's display pass ([`display`]), over the same prepared scene, parallel over rows
+//! with rayon and compiled per instruction-set level ([`InstructionSet`]). Its rays are
+//! traced in packets ([`packet`]) through the 4-wide BVH both backends walk. The tests
+//! render scenes on both backends and compare.
 
 pub mod bsdf;
 pub mod bvh;
