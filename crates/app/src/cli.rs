@@ -1,9 +1,12 @@
 //! Command-line interface (clap derive; doc comments are the help text).
 
+use std::ops::Range;
 use std::path::PathBuf;
 use std::time::Duration;
 
 use clap::{Parser, Subcommand, ValueEnum};
+
+use crate::shard::{Shard, parse_range, parse_shard};
 
 /// pathlight: a physically based, progressive path tracer running in WGSL compute shaders on
 /// any GPU, and on the CPU through Mesa's software adapters.
@@ -24,6 +27,8 @@ pub enum Command {
     View(ViewArgs),
     /// Measure frames per second, samples/s and rays/s (one sample per pixel per frame).
     Bench(BenchArgs),
+    /// Sum render states (shards, checkpoints) exactly into one image or state.
+    Merge(MergeArgs),
 }
 
 /// Where the light transport runs.
@@ -89,10 +94,12 @@ pub struct DeviceArgs {
 pub struct RenderArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
-    /// Output image: `.png` (sRGB, clamped, 8-bit) or `.exr` (linear float RGB).
+    /// Output: an image, `.png` (sRGB, clamped, 8-bit) or `.exr` (linear float RGB), or
+    /// `.state`, the exact sums for `pathlight merge` and `--resume`.
     #[arg(short, long, default_value = "pathlight.png")]
     pub output: PathBuf,
-    /// Samples per pixel (overrides the scene's `render.spp`).
+    /// Samples per pixel (overrides the scene's `render.spp`); with `--resume`, the sample
+    /// count to continue to.
     #[arg(long)]
     pub spp: Option<u32>,
     #[command(flatten)]
@@ -100,6 +107,49 @@ pub struct RenderArgs {
     /// List the adapters found and exit.
     #[arg(long)]
     pub list_adapters: bool,
+    /// Stop after this long (`90s`, `10m`, `1.5h`) and write what was rendered, as an
+    /// interrupted render does, but exiting with status 0.
+    #[arg(long, value_name = "DURATION", value_parser = duration)]
+    pub time_limit: Option<Duration>,
+    /// Keep the render's state in this file (written every `--checkpoint-every` and when the
+    /// render stops for any reason); `--resume FILE` continues it.
+    #[arg(long, value_name = "FILE")]
+    pub checkpoint: Option<PathBuf>,
+    /// How often `--checkpoint` is written.
+    #[arg(long, value_name = "DURATION", default_value = "60s", value_parser = duration)]
+    pub checkpoint_every: Duration,
+    /// Continue the render a state file holds (a checkpoint or a shard) to its target (or
+    /// to `--spp`); the scene and settings must be those it was rendered with.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["samples", "shard"])]
+    pub resume: Option<PathBuf>,
+    /// Render only the sample indices START..END of every pixel (a part for `pathlight
+    /// merge`), within the spp.
+    #[arg(long, value_name = "START..END", value_parser = parse_range, conflicts_with = "shard")]
+    pub samples: Option<Range<u32>>,
+    /// Render part I of N (from 0) of the spp, `I/N`; `auto` takes the part from a job
+    /// array's environment: Slurm ($SLURM_ARRAY_TASK_ID), Kubernetes Indexed Jobs
+    /// ($JOB_COMPLETION_INDEX), AWS Batch ($AWS_BATCH_JOB_ARRAY_INDEX).
+    #[arg(long, value_name = "I/N|auto", value_parser = parse_shard)]
+    pub shard: Option<Shard>,
+    /// The number of parts for `--shard auto` where the environment does not give it
+    /// (Kubernetes, AWS Batch).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub shard_count: Option<u32>,
+}
+
+/// Options of `pathlight merge`.
+#[derive(Debug, clap::Args)]
+pub struct MergeArgs {
+    /// State files (`render -o X.state`, `--checkpoint`) of one render.
+    #[arg(required = true, value_name = "PARTS")]
+    pub parts: Vec<PathBuf>,
+    /// The merged image (`.png`, `.exr`) or state (`.state`).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Write the image even when samples are missing (each pixel the mean of the samples
+    /// the parts hold).
+    #[arg(long)]
+    pub allow_gaps: bool,
 }
 
 /// How the nearest hit is found (`pathlight bench --accel`).

@@ -5,9 +5,11 @@ mod note;
 mod backend;
 mod bench;
 mod cli;
+mod merge;
 mod output;
 mod progress;
 mod render;
+mod shard;
 mod view;
 
 use std::process::ExitCode;
@@ -24,6 +26,7 @@ fn main() -> ExitCode {
         Some(cli::Command::Render(args)) => render::run(&args),
         Some(cli::Command::View(args)) => view::run(&args),
         Some(cli::Command::Bench(args)) => bench::run(&args),
+        Some(cli::Command::Merge(args)) => merge::run(&args),
         None => view::run(&cli::ViewArgs::defaults()),
     };
     match result {

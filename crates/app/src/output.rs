@@ -1,4 +1,5 @@
-//! Writing the film: PNG (sRGB curve, clamped) or EXR (linear float RGB), by extension.
+//! Writing the film: PNG (sRGB curve, clamped) or EXR (linear float RGB), or the render's
+//! state (its exact sums, `docs/state-format.md`), by extension.
 //!
 //! An existing file is replaced only by a complete image: the image is encoded in memory,
 //! written to a temporary file beside the target, flushed to the disk, and renamed over the
@@ -9,15 +10,18 @@ use std::path::Path;
 
 use anyhow::{Context, bail};
 use pathlight_core::Film;
+use pathlight_core::state::RenderState;
 use pathlight_scene::texture::linear_to_srgb;
 
-/// Image file formats pathlight writes.
+/// File formats pathlight writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Format {
     /// 8-bit sRGB PNG.
     Png,
     /// 32-bit float linear OpenEXR.
     Exr,
+    /// The render's state: its exact sums and samples.
+    State,
 }
 
 /// The format named by `path`'s extension.
@@ -30,8 +34,10 @@ pub fn format_of(path: &Path) -> anyhow::Result<Format> {
     {
         Some("png") => Ok(Format::Png),
         Some("exr") => Ok(Format::Exr),
+        Some("state") => Ok(Format::State),
         _ => bail!(
-            "output {}: unknown image format; use a .png or .exr extension",
+            "output {}: unknown format; use a .png or .exr extension (an image) or .state \
+             (the render's exact sums)",
             path.display()
         ),
     }
@@ -58,9 +64,10 @@ pub fn check_writable(path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The film encoded in `format`.
+/// The film encoded in `format` (an image format).
 fn encode(film: &Film, format: Format) -> anyhow::Result<Vec<u8>> {
     match format {
+        Format::State => bail!("a film has no state: only a render's sums make one"),
         Format::Png => {
             use image::ImageEncoder as _;
             let pixels: Vec<u8> = film
@@ -91,10 +98,27 @@ fn replace_file(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     Ok(())
 }
 
-/// Writes `film` to `path` in the format its extension names, replacing a file there only
-/// once the whole image is on the disk.
+/// Writes `film` to `path` in the image format its extension names, replacing a file
+/// there only once the whole image is on the disk.
 pub fn write(film: &Film, path: &Path) -> anyhow::Result<()> {
     let bytes = encode(film, format_of(path)?)
         .with_context(|| format!("cannot encode {}", path.display()))?;
     replace_file(path, &bytes).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Writes a render's `state` to `path`: the state itself (`.state`), or its image, replacing
+/// a file there only once all of it is on the disk.
+pub fn write_render(state: &RenderState, path: &Path) -> anyhow::Result<()> {
+    let bytes = match format_of(path)? {
+        Format::State => state.encode(),
+        format => encode(&state.film(), format)
+            .with_context(|| format!("cannot encode {}", path.display()))?,
+    };
+    replace_file(path, &bytes).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Reads the render state in `path`, naming the file in every error.
+pub fn read_state(path: &Path) -> anyhow::Result<RenderState> {
+    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    RenderState::decode(&bytes).with_context(|| format!("{}", path.display()))
 }

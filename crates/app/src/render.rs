@@ -1,10 +1,13 @@
 //! `pathlight render`: load, render progressively, write the image.
 
+use std::ops::Range;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
-use pathlight_core::PreparedScene;
+use anyhow::{Context, bail};
+use pathlight_core::state::{Fingerprint, RenderState};
+use pathlight_core::{Accumulation, PreparedScene, Renderer};
 use pathlight_render::Accel;
 use pathlight_render::context::{available_adapters, describe};
 use pathlight_scene::Scene;
@@ -14,6 +17,7 @@ use crate::backend::{Device, load_scene};
 use crate::cli::RenderArgs;
 use crate::output;
 use crate::progress::Progress;
+use crate::shard::part_of;
 
 /// The error of a render stopped by SIGINT or SIGTERM: the image with the samples rendered
 /// so far has been written (or nothing, before the first sample). The process exits with
@@ -48,7 +52,92 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     }
     check_spp(scene.settings.spp)?;
     output::check_writable(&args.output)?;
+    if let Some(checkpoint) = &args.checkpoint {
+        output::check_writable(checkpoint)?;
+    }
     render_to_file(&scene, args, &interrupted)
+}
+
+/// What a render starts from: the samples it is asked for and the sums it already has.
+struct Start {
+    target: Range<u32>,
+    accumulation: Accumulation,
+}
+
+/// The samples `args` ask for (all, `--samples`, `--shard`, or the rest of `--resume`'s
+/// state) and the sums to start from.
+fn start(scene: &Scene, args: &RenderArgs, fingerprint: &Fingerprint) -> anyhow::Result<Start> {
+    let spp = scene.settings.spp;
+    let (width, height) = (scene.camera.width, scene.camera.height);
+    if let Some(path) = &args.resume {
+        let state = output::read_state(path)?;
+        let differences = state
+            .fingerprint
+            .differences(fingerprint, (&path.display().to_string(), "this render"));
+        if !differences.is_empty() {
+            bail!(
+                "cannot resume {}: it is another render: {}",
+                path.display(),
+                differences.join("; ")
+            );
+        }
+        let accumulation = state
+            .accumulation()
+            .with_context(|| format!("cannot resume {}", path.display()))?;
+        let rendered = accumulation.first_sample + accumulation.samples;
+        let end = match args.spp {
+            Some(spp) => spp,
+            None => state.target.end,
+        };
+        if end < rendered + u32::from(accumulation.rows_ahead > 0) {
+            bail!(
+                "cannot resume {} to {end} spp: it holds samples {}..{rendered} already",
+                path.display(),
+                accumulation.first_sample
+            );
+        }
+        return Ok(Start {
+            target: state.target.start..end,
+            accumulation,
+        });
+    }
+    let target = match (&args.samples, args.shard) {
+        (Some(samples), _) => {
+            if samples.end > spp {
+                bail!(
+                    "--samples {}..{} reaches past the spp ({spp}): sample indices run \
+                     from 0 to {}",
+                    samples.start,
+                    samples.end,
+                    spp - 1
+                );
+            }
+            samples.clone()
+        }
+        (None, Some(shard)) => {
+            let (index, count) =
+                shard.resolve(args.shard_count, |name| std::env::var(name).ok())?;
+            let part = part_of(index, count, spp);
+            note!(
+                "shard {index} of {count}: samples {}..{}",
+                part.start,
+                part.end
+            );
+            part
+        }
+        (None, None) => 0..spp,
+    };
+    Ok(Start {
+        accumulation: Accumulation::empty(width, height, target.start),
+        target,
+    })
+}
+
+/// Why a render stopped before its target.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Stop {
+    Signal,
+    TimeLimit,
 }
 
 fn render_to_file(
@@ -58,6 +147,11 @@ fn render_to_file(
 ) -> anyhow::Result<()> {
     let started = Instant::now();
     let prepared = PreparedScene::new(scene)?;
+    let fingerprint = Fingerprint::new(&prepared, &scene.camera, &scene.settings);
+    let Start {
+        target,
+        accumulation,
+    } = start(scene, args, &fingerprint)?;
     let device = Device::open(&args.device)?;
     let mut renderer = device.renderer(scene, &prepared, Accel::Bvh)?;
     let kind = match device {
@@ -65,18 +159,55 @@ fn render_to_file(
         Device::Cpu => "backend",
     };
     note!("{kind}: {}", renderer.device());
+    let first_sample = accumulation.first_sample;
+    renderer.resume(&accumulation)?;
+    let total = target.end - first_sample;
+    if accumulation.samples > 0 {
+        note!(
+            "resuming at sample {} of {}..{}",
+            first_sample + accumulation.samples,
+            target.start,
+            target.end
+        );
+    }
+    let state_of = |renderer: &dyn Renderer| -> anyhow::Result<RenderState> {
+        Ok(RenderState::new(
+            fingerprint.clone(),
+            target.clone(),
+            renderer.device(),
+            renderer.accumulation()?,
+        ))
+    };
 
-    let total = scene.settings.spp;
     let (width, height) = (scene.camera.width, scene.camera.height);
     let mut progress = Progress::new(total, u64::from(width) * u64::from(height));
     let render_started = Instant::now();
-    while renderer.samples_done() < total && !interrupted.load(Ordering::SeqCst) {
+    let mut last_checkpoint = Instant::now();
+    let mut stop = None;
+    while renderer.samples_done() < total {
+        if interrupted.load(Ordering::SeqCst) {
+            stop = Some(Stop::Signal);
+            break;
+        }
+        if args
+            .time_limit
+            .is_some_and(|limit| render_started.elapsed() >= limit)
+        {
+            stop = Some(Stop::TimeLimit);
+            break;
+        }
         renderer.advance(total - renderer.samples_done())?;
         progress.update(renderer.samples_done());
+        if let Some(checkpoint) = &args.checkpoint
+            && last_checkpoint.elapsed() >= args.checkpoint_every
+        {
+            output::write_render(&state_of(renderer.as_ref())?, checkpoint)?;
+            last_checkpoint = Instant::now();
+        }
     }
     progress.finish();
     let render_time = render_started.elapsed();
-    let film = renderer.film()?;
+    let state = state_of(renderer.as_ref())?;
     let dropped = renderer.samples_dropped()?;
     if dropped > 0 {
         note!(
@@ -84,28 +215,42 @@ fn render_to_file(
              this is a bug in pathlight, please report it with the scene"
         );
     }
-    if film.spp == 0 {
-        note!("interrupted before the first sample; nothing written");
-        return Err(Interrupted.into());
+    if let Some(checkpoint) = &args.checkpoint {
+        output::write_render(&state, checkpoint)?;
+        note!("checkpoint {} written", checkpoint.display());
     }
-    output::write(&film, &args.output)?;
-    let stopped = film.spp < total;
-    if stopped {
-        note!(
-            "interrupted: kept {} of {total} spp (rows already sampled in the pass under way \
-             hold one more)",
-            film.spp
-        );
+    let spp = renderer.samples_done();
+    let has_samples = spp > 0 || state.rows.iter().any(|r| !r.is_empty());
+    if !has_samples && stop.is_some() {
+        note!("stopped before the first sample; no image written");
+        return match stop {
+            Some(Stop::Signal) => Err(Interrupted.into()),
+            _ => Ok(()),
+        };
+    }
+    output::write_render(&state, &args.output)?;
+    match stop {
+        Some(Stop::Signal) => note!(
+            "interrupted: kept {spp} of {total} spp (rows already sampled in the pass under way \
+             hold one more)"
+        ),
+        Some(Stop::TimeLimit) => note!(
+            "time limit reached: kept {spp} of {total} spp (rows already sampled in the pass \
+             under way hold one more)"
+        ),
+        None => {}
     }
     note!(
-        "wrote {}: {width}x{height}, {} spp, render {:.2} s ({:.2} M samples/s), total {:.2} s",
+        "wrote {}: {width}x{height}, {spp} spp (samples {}..{}), render {:.2} s ({:.2} M \
+         samples/s), total {:.2} s",
         args.output.display(),
-        film.spp,
+        first_sample,
+        first_sample + spp,
         render_time.as_secs_f64(),
-        progress.samples_per_second(film.spp) / 1e6,
+        progress.samples_per_second(spp) / 1e6,
         started.elapsed().as_secs_f64()
     );
-    if stopped {
+    if stop == Some(Stop::Signal) {
         return Err(Interrupted.into());
     }
     Ok(())

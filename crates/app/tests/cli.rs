@@ -145,7 +145,10 @@ fn bad_outputs_are_refused_before_rendering() {
     );
     let started = |err: &str| err.contains("adapter:") || err.contains("backend:");
     assert!(!started(&err), "rendering started:\n{err}");
-    let err = fails_with(&["render", "-o", "out.jpg"], &["out.jpg", ".png or .exr"]);
+    let err = fails_with(
+        &["render", "-o", "out.jpg"],
+        &["out.jpg", ".png or .exr", ".state"],
+    );
     assert!(!started(&err), "rendering started:\n{err}");
 }
 

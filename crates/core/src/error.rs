@@ -28,6 +28,9 @@ pub enum RenderError {
     /// The GPU failed while rendering or reading back.
     #[error("GPU failure: {0}")]
     Gpu(String),
+    /// Sums to resume from that do not fit the image.
+    #[error("cannot resume: {0}")]
+    Resume(String),
 }
 
 /// A scene whose geometry cannot be built into a BVH: a coordinate or a length that is not

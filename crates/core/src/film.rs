@@ -2,6 +2,7 @@
 //! sums, read from and written to OpenEXR, and compared with a reference.
 
 use crate::gpu_types::GpuAccumPixel;
+use crate::renderer::Accumulation;
 
 /// Mean linear RGB radiance per pixel, row 0 at the top.
 #[derive(Debug, Clone, PartialEq)]
@@ -27,19 +28,39 @@ impl Film {
         rows_ahead: u32,
         sums: &[GpuAccumPixel],
     ) -> Self {
+        let counts: Vec<u32> = (0..height)
+            .map(|y| spp + u32::from(y < rows_ahead))
+            .collect();
+        Self::from_row_sums(width, &counts, sums)
+    }
+
+    /// The image of a render's accumulation.
+    pub fn from_accumulation(width: u32, height: u32, accumulation: &Accumulation) -> Self {
+        Self::from_fixed_point(
+            width,
+            height,
+            accumulation.samples,
+            accumulation.rows_ahead,
+            &accumulation.sums,
+        )
+    }
+
+    /// The mean of fixed-point sums, row by row, where row `y` holds `counts[y]` samples per
+    /// pixel (a pixel without samples is black); `spp` is the smallest count.
+    pub fn from_row_sums(width: u32, counts: &[u32], sums: &[GpuAccumPixel]) -> Self {
         let pixels = sums
             .iter()
             .enumerate()
             .map(|(i, sum)| {
-                let ahead = (i / width as usize) < rows_ahead as usize;
-                let scale = 1.0 / f64::from((spp + u32::from(ahead)).max(1));
+                let count = counts[i / width as usize];
+                let scale = 1.0 / f64::from(count.max(1));
                 [0, 1, 2].map(|c| (sum.channel_sum(c) * scale) as f32)
             })
             .collect();
         Self {
             width,
-            height,
-            spp,
+            height: counts.len() as u32,
+            spp: counts.iter().copied().min().unwrap_or(0),
             pixels,
         }
     }
@@ -93,7 +114,13 @@ impl Film {
             let [r, g, b] = self.pixels[position.y() * width + position.x()];
             (r, g, b)
         });
-        let image = Image::from_channels((width, self.height as usize), channels);
+        // Chunks in increasing order: compressed in parallel, but written in one order, so
+        // that the same image always gives the same bytes (renders are compared by bytes).
+        let encoding = Encoding {
+            line_order: LineOrder::Increasing,
+            ..Encoding::FAST_LOSSLESS
+        };
+        let image = Image::from_encoded_channels((width, self.height as usize), encoding, channels);
         let mut bytes = Vec::new();
         image
             .write()
@@ -144,5 +171,33 @@ impl Film {
             }
         }
         sum / (3 * self.pixels.len()) as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Film;
+
+    /// The same image encodes to the same bytes (its tiles are compressed in parallel; they
+    /// were written in the order they finished, so equal renders compared unequal).
+    #[test]
+    fn exr_bytes_depend_only_on_the_image() {
+        let (width, height) = (600, 400);
+        let pixels = (0..width * height)
+            .map(|i| {
+                let v = ((i * 7919) % 1013) as f32 / 1013.0;
+                [v, v * 0.5, 1.0 - v]
+            })
+            .collect();
+        let film = Film {
+            width,
+            height,
+            spp: 1,
+            pixels,
+        };
+        let first = film.encode_exr().unwrap();
+        for _ in 0..4 {
+            assert!(film.encode_exr().unwrap() == first);
+        }
     }
 }

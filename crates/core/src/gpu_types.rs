@@ -277,6 +277,21 @@ pub struct GpuAccumPixel {
 }
 
 impl GpuAccumPixel {
+    /// `self += other` per channel on the 64-bit fixed point, saturating instead of
+    /// wrapping (WGSL `add_fixed`): exact, and the same in any order.
+    pub fn accumulate(&mut self, other: &Self) {
+        for c in 0..4 {
+            let (lo, carry) = self.lo[c].overflowing_add(other.lo[c]);
+            let (hi, wrapped) = self.hi[c].overflowing_add(other.hi[c]);
+            let (hi, carried_over) = hi.overflowing_add(u32::from(carry));
+            (self.hi[c], self.lo[c]) = if wrapped || carried_over {
+                (u32::MAX, u32::MAX)
+            } else {
+                (hi, lo)
+            };
+        }
+    }
+
     /// The sum of channel `c` as a float.
     pub fn channel_sum(&self, c: usize) -> f64 {
         f64::from(self.hi[c]) + f64::from(self.lo[c]) / 4_294_967_296.0

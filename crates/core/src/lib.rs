@@ -14,6 +14,7 @@ pub mod params;
 pub mod prepared;
 pub mod renderer;
 pub mod shading;
+pub mod state;
 pub mod textures;
 pub mod tonemap;
 
@@ -21,7 +22,7 @@ pub use error::{GeometryError, RenderError};
 pub use film::Film;
 pub use geometry::Geometry;
 pub use prepared::PreparedScene;
-pub use renderer::Renderer;
+pub use renderer::{Accumulation, Renderer};
 pub use shading::Shading;
 pub use textures::Textures;
 pub use tonemap::ToneMap;

@@ -282,14 +282,5 @@ pub fn add_sample(acc: &mut GpuAccumPixel, value: Vec3A) {
 /// `add_fixed`.
 #[inline(always)]
 pub fn add_fixed(acc: &mut GpuAccumPixel, x: &GpuAccumPixel) {
-    for c in 0..4 {
-        let (lo, carry) = acc.lo[c].overflowing_add(x.lo[c]);
-        let (hi, wrapped) = acc.hi[c].overflowing_add(x.hi[c]);
-        let (hi, carried_over) = hi.overflowing_add(u32::from(carry));
-        (acc.hi[c], acc.lo[c]) = if wrapped || carried_over {
-            (u32::MAX, u32::MAX)
-        } else {
-            (hi, lo)
-        };
-    }
+    acc.accumulate(x);
 }

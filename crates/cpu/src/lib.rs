@@ -23,7 +23,7 @@ use std::ops::Range;
 use std::time::{Duration, Instant};
 
 use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams};
-use pathlight_core::{Film, PreparedScene, RenderError, Renderer, Shading};
+use pathlight_core::{Accumulation, Film, PreparedScene, RenderError, Renderer, Shading};
 use pathlight_scene::{Camera, RenderSettings};
 use rayon::prelude::*;
 
@@ -46,6 +46,8 @@ pub struct CpuRenderer {
     /// same whatever order they were added in).
     sums: Vec<GpuAccumPixel>,
     samples_done: u32,
+    /// Index of every pixel's first sample.
+    first_sample: u32,
     /// Seconds one sample of one pixel took in the last render (`None` before the first).
     pixel_seconds: Option<f64>,
     /// Rows of the pass in progress that already hold its sample.
@@ -81,6 +83,7 @@ impl CpuRenderer {
             params,
             sums: vec![GpuAccumPixel::default(); pixels],
             samples_done: 0,
+            first_sample: 0,
             pixel_seconds: None,
             rows_ahead: 0,
             tally: Tally::default(),
@@ -101,10 +104,12 @@ impl CpuRenderer {
         Ok(())
     }
 
-    /// Adds `samples` samples per pixel (from sample `samples_done`) to the pixels of `rows`.
+    /// Adds `samples` samples per pixel (from sample `first_sample + samples_done`) to the
+    /// pixels of `rows`.
     fn render(&mut self, rows: Range<u32>, samples: u32) {
         let scene = CpuScene::new(&self.scene);
-        let (params, isa, offset) = (&self.params, self.isa, self.samples_done);
+        let offset = self.first_sample + self.samples_done;
+        let (params, isa) = (&self.params, self.isa);
         let width = params.width as usize;
         let pixels = rows.start as usize * width..rows.end as usize * width;
         let started = Instant::now();
@@ -157,7 +162,7 @@ impl CpuRenderer {
     /// The running sums, one per pixel, row by row, in the GPU's fixed point
     /// (`AccumPixel`): rows `0 .. rows_ahead()` hold `samples_done() + 1` samples, the
     /// others `samples_done()`.
-    pub fn accumulation(&self) -> &[GpuAccumPixel] {
+    pub fn sums(&self) -> &[GpuAccumPixel] {
         &self.sums
     }
 
@@ -193,6 +198,7 @@ impl Renderer for CpuRenderer {
     fn restart(&mut self) {
         self.sums.fill(GpuAccumPixel::default());
         self.samples_done = 0;
+        self.first_sample = 0;
         self.rows_ahead = 0;
         self.tally = Tally::default();
     }
@@ -241,6 +247,26 @@ impl Renderer for CpuRenderer {
         self.samples_done
     }
 
+    fn accumulation(&self) -> Result<Accumulation, RenderError> {
+        Ok(Accumulation {
+            first_sample: self.first_sample,
+            samples: self.samples_done,
+            rows_ahead: self.rows_ahead,
+            sums: self.sums.clone(),
+        })
+    }
+
+    fn resume(&mut self, from: &Accumulation) -> Result<(), RenderError> {
+        let (width, height) = self.size();
+        from.check_fits(width, height)?;
+        self.sums.copy_from_slice(&from.sums);
+        self.first_sample = from.first_sample;
+        self.samples_done = from.samples;
+        self.rows_ahead = from.rows_ahead;
+        self.tally = Tally::default();
+        Ok(())
+    }
+
     fn rays_traced(&self) -> Result<u64, RenderError> {
         Ok(self.tally.rays)
     }
@@ -251,12 +277,10 @@ impl Renderer for CpuRenderer {
 
     fn film(&self) -> Result<Film, RenderError> {
         let (width, height) = self.size();
-        Ok(Film::from_fixed_point(
+        Ok(Film::from_accumulation(
             width,
             height,
-            self.samples_done,
-            self.rows_ahead,
-            &self.sums,
+            &self.accumulation()?,
         ))
     }
 }

@@ -52,7 +52,7 @@ impl<'a> DisplaySource<'a> {
     pub fn of(renderer: &'a GpuRenderer) -> Self {
         let (width, height) = renderer.size();
         Self {
-            pixels: renderer.accumulation(),
+            pixels: renderer.accumulation_buffer(),
             width,
             height,
             samples: renderer.samples_done(),

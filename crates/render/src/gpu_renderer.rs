@@ -7,7 +7,7 @@
 use std::time::{Duration, Instant};
 
 use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams};
-use pathlight_core::{Film, PreparedScene, RenderError, Renderer, Shading};
+use pathlight_core::{Accumulation, Film, PreparedScene, RenderError, Renderer, Shading};
 use pathlight_scene::{Camera, RenderSettings};
 
 use crate::context::{GpuContext, describe};
@@ -85,6 +85,8 @@ pub struct GpuRenderer {
     stack_size: u32,
     /// Samples per pixel accumulated so far.
     samples_done: u32,
+    /// Index of every pixel's first sample.
+    first_sample: u32,
     /// Current piece size: rows per dispatch and samples per pixel per dispatch.
     rows_per_dispatch: u32,
     batch_samples: u32,
@@ -164,6 +166,7 @@ impl GpuRenderer {
             adaptive: true,
             params,
             samples_done: 0,
+            first_sample: 0,
         })
     }
 
@@ -184,7 +187,7 @@ impl GpuRenderer {
 
     /// The accumulation buffer (per pixel [`GpuAccumPixel`]: a fixed-point sum of samples),
     /// for a display pass to read.
-    pub fn accumulation(&self) -> &wgpu::Buffer {
+    pub fn accumulation_buffer(&self) -> &wgpu::Buffer {
         &self.accum_buffer
     }
 
@@ -204,7 +207,7 @@ impl GpuRenderer {
     /// Queues `samples` samples per pixel for rows `row .. row + rows`.
     fn submit(&self, row: u32, rows: u32, samples: u32) {
         let params = GpuRenderParams {
-            sample_offset: self.samples_done,
+            sample_offset: self.first_sample + self.samples_done,
             batch_samples: samples,
             row_offset: row,
             row_end: row + rows,
@@ -327,6 +330,7 @@ impl Renderer for GpuRenderer {
         encoder.clear_buffer(&self.counters, 0, None);
         self.ctx.queue.submit([encoder.finish()]);
         self.samples_done = 0;
+        self.first_sample = 0;
         self.rows_ahead = 0;
     }
 
@@ -392,6 +396,27 @@ impl Renderer for GpuRenderer {
         self.samples_done
     }
 
+    fn accumulation(&self) -> Result<Accumulation, RenderError> {
+        Ok(Accumulation {
+            first_sample: self.first_sample,
+            samples: self.samples_done,
+            rows_ahead: self.rows_ahead,
+            sums: self.read_buffer(&self.accum_buffer)?,
+        })
+    }
+
+    fn resume(&mut self, from: &Accumulation) -> Result<(), RenderError> {
+        from.check_fits(self.params.width, self.params.height)?;
+        self.restart();
+        self.ctx
+            .queue
+            .write_buffer(&self.accum_buffer, 0, bytemuck::cast_slice(&from.sums));
+        self.first_sample = from.first_sample;
+        self.samples_done = from.samples;
+        self.rows_ahead = from.rows_ahead;
+        Ok(())
+    }
+
     fn rays_traced(&self) -> Result<u64, RenderError> {
         let words: Vec<u32> = self.read_buffer(&self.counters)?;
         Ok(u64::from(words[0]) | (u64::from(words[1]) << 32))
@@ -405,14 +430,11 @@ impl Renderer for GpuRenderer {
     /// Copies the accumulation back and divides by each pixel's sample count. `spp` of the
     /// film counts whole frames only.
     fn film(&self) -> Result<Film, RenderError> {
-        let accum: Vec<GpuAccumPixel> = self.read_buffer(&self.accum_buffer)?;
         let (width, height) = self.size();
-        Ok(Film::from_fixed_point(
+        Ok(Film::from_accumulation(
             width,
             height,
-            self.samples_done,
-            self.rows_ahead,
-            &accum,
+            &Renderer::accumulation(self)?,
         ))
     }
 

@@ -376,7 +376,7 @@ fn render_loop(mut renderer: CpuRenderer, shared: &Shared, notify: impl Fn()) {
 /// of it when `image` held another restart than `epoch`.
 fn publish(renderer: &CpuRenderer, epoch: u64, rows: Range<u32>, image: &mut Image) {
     let (width, height) = renderer.size();
-    let sums = renderer.accumulation();
+    let sums = renderer.sums();
     if image.epoch != epoch || (image.width, image.height) != (width, height) {
         image.pixels.clear();
         image.pixels.extend_from_slice(sums);

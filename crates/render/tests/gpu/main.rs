@@ -5,5 +5,6 @@ mod display;
 mod extreme;
 mod furnace;
 mod render;
+mod state;
 mod trace;
 mod twin;
