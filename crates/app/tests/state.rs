@@ -149,18 +149,21 @@ fn merges_refuse_overlaps_gaps_and_other_renders_without_writing() {
     );
 }
 
+/// A CPU render of the default scene at 40x40.
+const RENDER_40: [&str; 7] = [
+    "render",
+    "--backend",
+    "cpu",
+    "--width",
+    "40",
+    "--height",
+    "40",
+];
+
 /// Starts a checkpointed CPU render of the default scene at 40x40 and `spp`.
 fn spawn_checkpointed(spp: &str, checkpoint: &str, out: &str) -> Child {
     Command::new(env!("CARGO_BIN_EXE_pathlight"))
-        .args([
-            "render",
-            "--backend",
-            "cpu",
-            "--width",
-            "40",
-            "--height",
-            "40",
-        ])
+        .args(RENDER_40)
         .args([
             "--spp",
             spp,
@@ -197,19 +200,9 @@ fn resumed_renders_equal_the_uninterrupted_one() {
     let dir = tempfile::tempdir().unwrap();
     let spp = "300";
     let whole = path(dir.path(), "whole.exr");
-    let output = pathlight(&[
-        "render",
-        "--backend",
-        "cpu",
-        "--width",
-        "40",
-        "--height",
-        "40",
-        "--spp",
-        spp,
-        "-o",
-        &whole,
-    ]);
+    let mut args = RENDER_40.to_vec();
+    args.extend(["--spp", spp, "-o", &whole]);
+    let output = pathlight(&args);
     assert!(output.status.success(), "{}", stderr(&output));
     for signal in ["INT", "TERM", "KILL"] {
         let checkpoint = path(dir.path(), &format!("{signal}.state"));
@@ -225,15 +218,7 @@ fn resumed_renders_equal_the_uninterrupted_one() {
             assert_eq!(status.code(), Some(130), "{signal}: {status}");
         }
         let output = Command::new(env!("CARGO_BIN_EXE_pathlight"))
-            .args([
-                "render",
-                "--backend",
-                "cpu",
-                "--width",
-                "40",
-                "--height",
-                "40",
-            ])
+            .args(RENDER_40)
             .args(["--resume", &checkpoint, "-o", &out])
             .output()
             .unwrap();
