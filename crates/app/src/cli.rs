@@ -133,7 +133,7 @@ pub struct RenderArgs {
     pub shard: Option<Shard>,
     /// The number of parts for `--shard auto` where the environment does not give it
     /// (Kubernetes, AWS Batch).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "N", requires = "shard", value_parser = clap::value_parser!(u32).range(1..))]
     pub shard_count: Option<u32>,
 }
 

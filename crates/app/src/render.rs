@@ -53,6 +53,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     check_spp(scene.settings.spp)?;
     output::check_writable(&args.output)?;
     if let Some(checkpoint) = &args.checkpoint {
+        if output::format_of(checkpoint).ok() != Some(output::Format::State) {
+            bail!(
+                "--checkpoint {}: a checkpoint is a state file; give it the .state extension",
+                checkpoint.display()
+            );
+        }
         output::check_writable(checkpoint)?;
     }
     render_to_file(&scene, args, &interrupted)

@@ -1,6 +1,10 @@
 //! The `pathlight` binary end to end: the furnace command, PNG and EXR output, and
 //! every class of bad input failing with a clear message and a non-zero status.
 
+mod common;
+
+use common::{send, stderr};
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -14,10 +18,6 @@ fn pathlight(args: &[&str]) -> Output {
         .current_dir(repo())
         .output()
         .expect("the binary runs")
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
 }
 
 fn fails_with(args: &[&str], needles: &[&str]) -> String {
@@ -256,15 +256,6 @@ fn unwritable_stderr_still_writes_the_image() {
     let status = child.wait().unwrap();
     assert!(status.success(), "{status}");
     assert!(std::fs::metadata(&out).unwrap().len() > 0);
-}
-
-/// Sends `signal` (`INT`, `TERM`, `KILL`) to process `pid`.
-fn send(signal: &str, pid: u32) {
-    let sent = Command::new("kill")
-        .args([&format!("-{signal}"), &pid.to_string()])
-        .status()
-        .unwrap();
-    assert!(sent.success());
 }
 
 /// Ctrl-C (SIGINT) and SIGTERM (what `kill`, `timeout`, systemd and job schedulers send)

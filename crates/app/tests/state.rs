@@ -3,6 +3,10 @@
 //! checkpoints, resuming after SIGINT, SIGTERM and SIGKILL, time limits, shards and merges,
 //! each compared byte for byte with the image one uninterrupted render makes.
 
+mod common;
+
+use common::{send, stderr};
+
 use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -14,10 +18,6 @@ fn pathlight(args: &[&str]) -> Output {
         .expect("the binary runs")
 }
 
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
 /// The default scene, small, on the CPU backend.
 const SMALL: [&str; 6] = ["--backend", "cpu", "--width", "24", "--height", "16"];
 
@@ -25,11 +25,17 @@ fn path(dir: &Path, name: &str) -> String {
     dir.join(name).to_str().unwrap().to_owned()
 }
 
-/// Renders with `SMALL` and `args`; fails the test unless it succeeds.
-fn render(args: &[&str]) -> String {
+/// `pathlight render` with `SMALL` and `args`.
+fn small<'a>(args: &[&'a str]) -> Vec<&'a str> {
     let mut all = vec!["render"];
     all.extend(SMALL);
     all.extend(args);
+    all
+}
+
+/// Renders with `SMALL` and `args`; fails the test unless it succeeds.
+fn render(args: &[&str]) -> String {
+    let all = small(args);
     let output = pathlight(&all);
     let err = stderr(&output);
     assert!(output.status.success(), "{all:?}:\n{err}");
@@ -178,14 +184,6 @@ fn spawn_checkpointed(spp: &str, checkpoint: &str, out: &str) -> Child {
         .unwrap()
 }
 
-fn send(signal: &str, pid: u32) {
-    let sent = Command::new("kill")
-        .args([&format!("-{signal}"), &pid.to_string()])
-        .status()
-        .unwrap();
-    assert!(sent.success());
-}
-
 /// Waits until `file` exists (the first checkpoint).
 fn wait_for(file: &str) {
     let started = Instant::now();
@@ -241,47 +239,28 @@ fn resuming_refuses_another_render_and_a_target_already_passed() {
     let state = path(dir.path(), "s.state");
     render(&["--spp", "4", "-o", &state]);
     let out = path(dir.path(), "out.exr");
+    let mut taller = RENDER_40.to_vec();
+    taller.extend(["--resume", &state, "-o", &out]);
     fails(
-        &[
-            "render",
-            "--backend",
-            "cpu",
-            "--width",
-            "24",
-            "--height",
-            "20",
-            "--resume",
-            &state,
-            "-o",
-            &out,
-        ],
-        &["s.state", "image size 24x16 in", "24x20 in this render"],
+        &taller,
+        &["s.state", "image size 24x16 in", "40x40 in this render"],
     );
     fails(
-        &[
-            "render",
-            "--backend",
-            "cpu",
-            "--width",
-            "24",
-            "--height",
-            "16",
-            "--max-depth",
-            "3",
-            "--resume",
-            &state,
-            "-o",
-            &out,
-        ],
+        &small(&["--max-depth", "3", "--resume", &state, "-o", &out]),
         &["max_depth 8 in", "3 in this render"],
     );
-    let mut args = vec!["render"];
-    args.extend(SMALL);
-    args.extend(["--resume", &state, "--spp", "2", "-o", &out]);
     fails(
-        &args,
+        &small(&["--resume", &state, "--spp", "2", "-o", &out]),
         &["cannot resume", "to 2 spp", "samples 0..4 already"],
     );
+    // A checkpoint must be a state; a shard count needs a shard.
+    fails(
+        &small(&["--checkpoint", "c.png", "-o", &out]),
+        &["--checkpoint c.png", ".state"],
+    );
+    let output = pathlight(&small(&["--shard-count", "4", "-o", &out]));
+    assert_eq!(output.status.code(), Some(2), "clap's usage error");
+    assert!(stderr(&output).contains("--shard"), "{}", stderr(&output));
     // A finished state resumed to more samples equals rendering them at once.
     render(&["--resume", &state, "--spp", "6", "-o", &out]);
     let whole = path(dir.path(), "whole.exr");

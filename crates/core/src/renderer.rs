@@ -45,7 +45,7 @@ impl Accumulation {
                 self.rows_ahead
             )));
         }
-        if self.first_sample.checked_add(self.samples + 1).is_none() {
+        if u64::from(self.first_sample) + u64::from(self.samples) + 1 > u64::from(u32::MAX) {
             return Err(RenderError::Resume(format!(
                 "samples {}..{} run past the last sample index",
                 self.first_sample,

@@ -4,6 +4,7 @@
 
 use std::ops::Range;
 
+use pathlight_scene::settings::check_resolution;
 use pathlight_scene::{Camera, RenderSettings, Sampler};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -206,13 +207,19 @@ impl RenderState {
     pub fn accumulation(&self) -> Result<Accumulation, StateError> {
         let first = self.rows.first().map_or(self.target.start, |r| r.start);
         let last = self.rows.last().map_or(first, |r| r.end);
-        let ahead = self.rows.iter().take_while(|r| r.end == last + 1).count() as u32;
+        // In u64: a file may hold any u32 range, `u32::MAX` included.
+        let end_of = |y: usize, ahead: usize| u64::from(last) + u64::from(y < ahead);
+        let ahead = self
+            .rows
+            .iter()
+            .take_while(|r| u64::from(r.end) == end_of(0, 1))
+            .count();
         let fits = self
             .rows
             .iter()
             .enumerate()
-            .all(|(y, r)| r.start == first && r.end == last + u32::from((y as u32) < ahead));
-        if !fits || (ahead > 0 && ahead == self.fingerprint.height) {
+            .all(|(y, r)| r.start == first && u64::from(r.end) == end_of(y, ahead));
+        if !fits || (ahead > 0 && ahead == self.rows.len()) {
             return Err(StateError::Mismatch(
                 "its rows hold samples no single render leaves (a merge with gaps?); only \
                  the image can be made from it"
@@ -222,7 +229,7 @@ impl RenderState {
         Ok(Accumulation {
             first_sample: first,
             samples: last - first,
-            rows_ahead: ahead,
+            rows_ahead: ahead as u32,
             sums: self.sums.clone(),
         })
     }
@@ -293,6 +300,8 @@ impl RenderState {
         let header: Header = serde_json::from_slice(&body[PREAMBLE..header_end])
             .map_err(|err| StateError::Corrupt(format!("the header: {err}")))?;
         let (width, height) = (header.fingerprint.width, header.fingerprint.height);
+        check_resolution(width, height)
+            .map_err(|err| StateError::Corrupt(format!("the header: {err}")))?;
         let rows_len = height as usize * 8;
         let sums_len = width as usize * height as usize * 32;
         if body.len() - header_end != rows_len + sums_len {
@@ -516,6 +525,33 @@ mod tests {
         for len in [0, 10, 30, bytes.len() / 2, bytes.len() - 1] {
             assert!(RenderState::decode(&bytes[..len]).is_err(), "cut at {len}");
         }
+    }
+
+    /// Files with a valid checksum but absurd contents (as a hand-made or foreign tool's
+    /// file could have) are refused without a panic or an overflow.
+    #[test]
+    fn absurd_but_well_formed_states_are_refused() {
+        for (width, height) in [(0, 2), (3, 0), (100_000, 2)] {
+            let mut absurd = state(0, 1, false, 0..1);
+            absurd.fingerprint.width = width;
+            absurd.fingerprint.height = height;
+            let err = RenderState::decode(&absurd.encode()).unwrap_err();
+            assert!(
+                err.to_string().contains("resolution"),
+                "{width}x{height}: {err}"
+            );
+        }
+        // Samples up to the last index: the state reads, but nothing resumes past it.
+        let mut last = state(0, 1, false, 0..u32::MAX);
+        last.rows = vec![u32::MAX - 1..u32::MAX, u32::MAX - 1..u32::MAX];
+        let read = RenderState::decode(&last.encode()).unwrap();
+        let accumulation = read.accumulation().unwrap();
+        assert!(accumulation.check_fits(3, 2).is_err());
+        last.rows = vec![u32::MAX - 1..u32::MAX, u32::MAX - 2..u32::MAX - 1];
+        assert!(
+            last.accumulation().is_err(),
+            "rows from different first samples"
+        );
     }
 
     #[test]

@@ -17,12 +17,10 @@ use pathlight_cpu::display::{CpuDisplay, DisplayImage};
 use pathlight_render::display::DisplaySource;
 use pathlight_scene::Camera;
 
-use crate::view::frames::{Frames, Rendered, Target};
+use crate::view::frames::{Frames, Rendered, Target, WHOLE_FRAME};
 
 /// Aimed-for time of one band of rows: how long a camera move may wait for the thread.
 const BAND: Duration = Duration::from_millis(40);
-/// The same for a preview frame: long enough for a whole one.
-const WHOLE_FRAME: Duration = Duration::from_secs(10);
 
 /// The image as the thread last left it.
 #[derive(Debug, Default)]

@@ -84,8 +84,9 @@ pub trait Frames {
     }
 }
 
-/// Aimed-for time of a submission of a preview frame: long enough for a whole frame.
-const WHOLE_FRAME: Duration = Duration::from_secs(10);
+/// Aimed-for time of a preview frame's submission or band (either backend): long enough
+/// for a whole frame.
+pub const WHOLE_FRAME: Duration = Duration::from_secs(10);
 
 /// The GPU backend, on the device that presents to the window.
 pub struct GpuFrames {
