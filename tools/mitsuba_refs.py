@@ -4,7 +4,8 @@
 Converts scenes/refs/NAME.toml (the subset with an exact Mitsuba equivalent: quads, spheres,
 OBJ meshes with scale + translate, emissive shapes as one-sided `area` emitters, two-sided
 diffuse, smooth or GGX-rough conductors and dielectrics with alpha = roughness^2, a
-constant environment) to a Mitsuba scene and either
+constant environment or an `envmap` with its scale and rotation about +y, a pinhole or a
+`thinlens` camera) to a Mitsuba scene and either
 
   render NAME [--res 512] [--spp 1024]   writes scenes/refs/images/NAME.exr and .png: the
                                          2x2 box average of a res x res render (the
@@ -117,20 +118,32 @@ def to_mitsuba(scene, res, spp):
         raise SystemExit("reference scenes must use color_space = \"linear\"")
     cam = scene["camera"]
     render = scene.get("render", {})
+    sensor_type = "perspective"
+    lens = {}
+    if cam.get("aperture_radius", 0.0) > 0.0:
+        focus = cam.get("focus_distance", float(np.linalg.norm(np.subtract(cam["look_at"], cam["position"]))))
+        sensor_type = "thinlens"
+        lens = {"aperture_radius": cam["aperture_radius"], "focus_distance": focus}
     out = {
         "type": "scene",
         "integrator": {"type": "path", "max_depth": render.get("max_depth", 8),
                        "rr_depth": render.get("rr_depth", 5), "hide_emitters": False},
         "sensor": {
-            "type": "perspective", "fov": cam["fov_y"], "fov_axis": "y",
+            "type": sensor_type, "fov": cam["fov_y"], "fov_axis": "y", **lens,
             "to_world": T().look_at(origin=cam["position"], target=cam["look_at"], up=cam.get("up", [0, 1, 0])),
             "film": {"type": "hdrfilm", "width": res, "height": res, "pixel_format": "rgb",
                      "rfilter": {"type": "box"}},
             "sampler": {"type": "independent", "sample_count": spp},
         },
     }
-    if "environment" in scene:
-        out["environment"] = {"type": "constant", "radiance": rgb(scene["environment"]["radiance"])}
+    env = scene.get("environment")
+    if env and "map" in env:
+        # pathlight's map convention is Mitsuba's, its rotation Mitsuba's to_world about +y.
+        out["environment"] = {"type": "envmap", "filename": os.path.join(REFS, env["map"]),
+                              "scale": env.get("strength", 1.0),
+                              "to_world": T().rotate([0, 1, 0], env.get("rotation", 0.0))}
+    elif env:
+        out["environment"] = {"type": "constant", "radiance": rgb(env["radiance"])}
     materials = scene["materials"]
 
     def attach(shape, mat_name):

@@ -1,13 +1,15 @@
 //! What every command does first: load the scene, apply the command line's overrides,
 //! prepare it once, and open the backend that renders it.
 
+use std::sync::Arc;
+
 use anyhow::Context;
 use pathlight_core::{PreparedScene, Renderer};
 use pathlight_cpu::{CpuRenderer, InstructionSet};
 use pathlight_render::context::{AutoChoice, auto_choice, available_adapters, describe};
 use pathlight_render::{Accel, GpuContext, GpuRenderer};
 use pathlight_scene::settings::{check_max_depth, check_resolution};
-use pathlight_scene::{Sampler, Scene, default_scene, load_scene_file};
+use pathlight_scene::{Environment, HdrImage, Sampler, Scene, default_scene, load_scene_file};
 
 use crate::cli::{Backend, DeviceArgs, SamplerChoice, SceneArgs};
 
@@ -38,7 +40,62 @@ pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Scene> {
             SamplerChoice::Independent => Sampler::Independent,
         };
     }
+    apply_environment(&mut scene, args)?;
+    apply_lens(&mut scene, args)?;
     Ok(scene)
+}
+
+/// `--env`, `--env-strength` and `--env-rotation`.
+fn apply_environment(scene: &mut Scene, args: &SceneArgs) -> anyhow::Result<()> {
+    if let Some(strength) = args.env_strength {
+        anyhow::ensure!(
+            strength.is_finite() && strength >= 0.0,
+            "--env-strength {strength} must be finite and >= 0"
+        );
+    }
+    if let Some(rotation) = args.env_rotation {
+        anyhow::ensure!(
+            rotation.is_finite(),
+            "--env-rotation {rotation} must be finite"
+        );
+    }
+    let (image, strength, rotation) = match (&args.env, &scene.environment) {
+        (Some(path), _) => (Arc::new(HdrImage::open(path)?), 1.0, 0.0),
+        (None, Environment::Map(map)) => (map.image.clone(), map.strength, map.rotation_deg),
+        (None, Environment::Constant(_)) => {
+            anyhow::ensure!(
+                args.env_strength.is_none() && args.env_rotation.is_none(),
+                "--env-strength and --env-rotation need an environment map (--env FILE, or \
+                 `map` in the scene's [environment])"
+            );
+            return Ok(());
+        }
+    };
+    scene.environment = Environment::from_map(
+        image,
+        args.env_strength.unwrap_or(strength),
+        args.env_rotation.unwrap_or(rotation),
+    );
+    Ok(())
+}
+
+/// `--aperture` and `--focus-distance`.
+fn apply_lens(scene: &mut Scene, args: &SceneArgs) -> anyhow::Result<()> {
+    if let Some(radius) = args.aperture {
+        anyhow::ensure!(
+            radius.is_finite() && radius >= 0.0,
+            "--aperture {radius} must be finite and >= 0"
+        );
+        scene.camera.aperture_radius = radius;
+    }
+    if let Some(distance) = args.focus_distance {
+        anyhow::ensure!(
+            distance.is_finite() && distance > 0.0,
+            "--focus-distance {distance} must be finite and > 0"
+        );
+        scene.camera.focus_distance = distance;
+    }
+    Ok(())
 }
 
 /// The device a command renders on: a wgpu adapter, or the CPU backend.

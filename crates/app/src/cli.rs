@@ -64,6 +64,23 @@ pub struct SceneArgs {
     /// Sample generator (overrides the scene's `render.sampler`).
     #[arg(long, value_enum)]
     pub sampler: Option<SamplerChoice>,
+    /// Light the scene with this equirectangular HDR map (`.exr`, `.hdr`; replaces the
+    /// scene's `[environment]`).
+    #[arg(long, value_name = "FILE")]
+    pub env: Option<PathBuf>,
+    /// Factor on the environment map's texels (with `--env`, or on the scene's map).
+    #[arg(long, value_name = "FACTOR", allow_hyphen_values = true)]
+    pub env_strength: Option<f32>,
+    /// Turn of the environment map about the up axis, degrees (with `--env`, or the scene's).
+    #[arg(long, value_name = "DEGREES", allow_hyphen_values = true)]
+    pub env_rotation: Option<f32>,
+    /// Radius of the thin lens (overrides `camera.aperture_radius`; 0 is a pinhole).
+    #[arg(long, value_name = "RADIUS", allow_hyphen_values = true)]
+    pub aperture: Option<f32>,
+    /// Distance of the plane in focus along the view direction (overrides
+    /// `camera.focus_distance`).
+    #[arg(long, value_name = "DISTANCE", allow_hyphen_values = true)]
+    pub focus_distance: Option<f32>,
 }
 
 /// The sample generators `--sampler` offers.
@@ -239,6 +256,11 @@ impl ViewArgs {
                 seed: None,
                 max_depth: None,
                 sampler: None,
+                env: None,
+                env_strength: None,
+                env_rotation: None,
+                aperture: None,
+                focus_distance: None,
             },
             frames_per_iter: 512,
             iters: 8,

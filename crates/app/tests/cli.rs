@@ -507,3 +507,68 @@ fn sampler_option_overrides_the_scene() {
         "{err}"
     );
 }
+
+/// `--env` lights a scene with a map: the furnace's background then reads the map (the
+/// scene file's constant 1 is replaced), `--env-strength` scales it, and the lens options
+/// apply; bad values name themselves.
+#[test]
+fn env_and_lens_options_replace_the_scenes() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = |extra: &[&str], name: &str| {
+        let out = dir.path().join(name);
+        let mut args = vec!["render", "scenes/refs/furnace-0.8.toml", "--spp", "2"];
+        args.extend(SMALL_ON_CPU);
+        args.extend(extra);
+        args.extend(["-o", out.to_str().unwrap()]);
+        let output = pathlight(&args);
+        assert!(output.status.success(), "{args:?}: {}", stderr(&output));
+        pathlight_core::Film::read_exr(&out).unwrap()
+    };
+    let plain = render(&[], "plain.exr");
+    assert_eq!(plain.pixel(0, 0), [1.0; 3]);
+    let sky = render(&["--env", "assets/env/city.exr"], "sky.exr");
+    let brighter = render(
+        &["--env", "assets/env/city.exr", "--env-strength", "2"],
+        "brighter.exr",
+    );
+    let corner = sky.pixel(0, 0);
+    assert!(
+        corner != [1.0; 3] && corner.iter().all(|c| *c > 0.0),
+        "{corner:?}"
+    );
+    for (twice, once) in brighter.pixel(0, 0).iter().zip(corner) {
+        assert!((twice - 2.0 * once).abs() <= 1e-5 * once);
+    }
+    let lens = render(&["--aperture", "0.2", "--focus-distance", "1"], "lens.exr");
+    assert!(lens.pixels != plain.pixels);
+    let zero = render(&["--aperture", "0", "--focus-distance", "9"], "zero.exr");
+    assert!(
+        zero.pixels == plain.pixels,
+        "a lens of radius 0 is the pinhole"
+    );
+    for (args, needles) in [
+        (vec!["--env", "no/such.exr"], vec!["no/such.exr"]),
+        (
+            vec!["--env", "Cargo.toml"],
+            vec!["Cargo.toml", "cannot decode image"],
+        ),
+        (
+            vec!["--env-rotation", "10"],
+            vec!["--env-rotation need an environment map"],
+        ),
+        (
+            vec!["--aperture", "-1"],
+            vec!["--aperture -1 must be finite and >= 0"],
+        ),
+        (
+            vec!["--focus-distance", "0"],
+            vec!["--focus-distance 0 must be finite and > 0"],
+        ),
+    ] {
+        let mut all = vec!["render", "scenes/refs/furnace-0.8.toml"];
+        all.extend(SMALL_ON_CPU);
+        all.extend(args);
+        all.extend(["-o", "/tmp/never-written.png"]);
+        fails_with(&all, &needles);
+    }
+}

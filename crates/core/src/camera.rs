@@ -16,9 +16,9 @@ impl GpuCamera {
         let aspect = camera.width as f32 / camera.height as f32;
         Self {
             position: camera.position.to_array(),
-            pad0: 0,
+            lens_radius: camera.aperture_radius,
             forward: forward.to_array(),
-            pad1: 0,
+            focus_distance: camera.focus_distance,
             right: (right * tan_half * aspect).to_array(),
             pad2: 0,
             up: (up * tan_half).to_array(),

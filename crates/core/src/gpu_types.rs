@@ -205,14 +205,14 @@ const _: () = assert!(size_of::<GpuTextureInfo>() == 16);
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuCamera {
-    /// Eye position.
+    /// Eye position (the lens centre).
     pub position: [f32; 3],
-    /// Padding.
-    pub pad0: u32,
+    /// Radius of the thin lens; 0 for a pinhole.
+    pub lens_radius: f32,
     /// Unit view direction.
     pub forward: [f32; 3],
-    /// Padding.
-    pub pad1: u32,
+    /// Distance along `forward` of the plane in focus.
+    pub focus_distance: f32,
     /// Right vector scaled to half the image width at unit distance.
     pub right: [f32; 3],
     /// Padding.
@@ -259,8 +259,20 @@ pub struct GpuRenderParams {
     pub object_count: u32,
     /// Number of entries in the light table.
     pub light_count: u32,
+    /// Environment map width in texels; 0 when there is none.
+    pub env_width: u32,
+    /// Environment map height in texels.
+    pub env_height: u32,
+    /// Factor from decoded environment texels to radiance.
+    pub env_scale: f32,
+    /// Padding.
+    pub pad0: u32,
+    /// Cosine and sine of the map's turn about +y.
+    pub env_rotation: [f32; 2],
+    /// Padding.
+    pub pad1: [u32; 2],
 }
-const _: () = assert!(size_of::<GpuRenderParams>() == 128);
+const _: () = assert!(size_of::<GpuRenderParams>() == 160);
 
 /// One pixel of the accumulation buffer. WGSL: `AccumPixel`.
 ///

@@ -5,6 +5,7 @@
 
 pub mod bvh;
 pub mod camera;
+pub mod environment;
 pub mod error;
 pub mod film;
 pub mod geometry;
@@ -18,6 +19,7 @@ pub mod state;
 pub mod textures;
 pub mod tonemap;
 
+pub use environment::EnvironmentData;
 pub use error::{GeometryError, RenderError};
 pub use film::Film;
 pub use geometry::Geometry;

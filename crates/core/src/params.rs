@@ -51,13 +51,20 @@ impl GpuRenderParams {
     /// Takes the environment, the counts and the split between the environment and the
     /// shape lights from `shading`.
     pub fn set_shading(&mut self, shading: &Shading) {
-        let has_env = shading.environment.max_element() > 0.0;
+        let has_env = shading.environment.max_element() > 0.0
+            || shading.environment_map.is_some_and(|m| m.scale > 0.0);
         self.env_pmf = match (has_env, shading.light_count > 0) {
             (false, _) => 0.0,
             (true, false) => 1.0,
             (true, true) => ENV_SHARE,
         };
         self.environment = shading.environment.to_array();
+        let map = shading.environment_map;
+        self.env_width = map.map_or(0, |m| m.width);
+        self.env_height = map.map_or(0, |m| m.height);
+        self.env_scale = map.map_or(0.0, |m| m.scale);
+        let rotation = map.map_or(0.0, |m| m.rotation);
+        self.env_rotation = [rotation.cos(), rotation.sin()];
         self.object_count = shading.object_count;
         self.light_count = shading.light_count;
     }

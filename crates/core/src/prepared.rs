@@ -2,8 +2,9 @@
 
 use std::sync::Arc;
 
-use pathlight_scene::Scene;
+use pathlight_scene::{Environment, Scene};
 
+use crate::environment::EnvironmentData;
 use crate::error::GeometryError;
 use crate::geometry::Geometry;
 use crate::shading::Shading;
@@ -18,6 +19,8 @@ pub struct PreparedScene {
     pub geometry: Arc<Geometry>,
     /// Texels.
     pub textures: Arc<Textures>,
+    /// The environment map's texels and sampling distribution (placeholders without one).
+    pub environment: Arc<EnvironmentData>,
     /// Materials, lights, environment.
     pub shading: Shading,
 }
@@ -31,12 +34,17 @@ impl PreparedScene {
         Ok(Self {
             geometry: Arc::new(geometry),
             textures: Arc::new(Textures::build(&scene.textures)),
+            environment: Arc::new(match &scene.environment {
+                Environment::Map(map) => EnvironmentData::build(&map.image),
+                Environment::Constant(_) => EnvironmentData::none(),
+            }),
             shading,
         })
     }
 
     /// The shading of `scene`, whose objects must be this scene's (only their materials,
-    /// the materials themselves and the environment may differ). Textures are kept: a
+    /// the materials themselves and a constant environment may differ; an environment map
+    /// must be this scene's, its strength and rotation may differ). Textures are kept: a
     /// material may only use the textures the scene was prepared with.
     pub fn shading_of(&self, scene: &Scene) -> Shading {
         Shading::build(scene, &self.geometry)

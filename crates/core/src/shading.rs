@@ -4,8 +4,9 @@
 
 use bytemuck::Zeroable;
 use glam::Vec3;
-use pathlight_scene::{Conductor, Material, Scene};
+use pathlight_scene::{Conductor, Environment, Material, Scene};
 
+use crate::environment::texel_scale;
 use crate::geometry::Geometry;
 use crate::gpu_types::{GpuLight, GpuMaterial, GpuObject};
 use crate::light_table;
@@ -24,8 +25,23 @@ pub struct Shading {
     pub lights: Vec<GpuLight>,
     /// Number of real light-table entries.
     pub light_count: u32,
-    /// Constant environment radiance.
+    /// Constant environment radiance (zero with a map).
     pub environment: Vec3,
+    /// The environment map's size and placement, when there is one.
+    pub environment_map: Option<MapPlacement>,
+}
+
+/// An environment map's size and how the scene places it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapPlacement {
+    /// Width in texels.
+    pub width: u32,
+    /// Height in texels.
+    pub height: u32,
+    /// Factor from decoded texels to radiance: the strength times [`texel_scale`].
+    pub scale: f32,
+    /// Turn about +y, radians.
+    pub rotation: f32,
 }
 
 impl Shading {
@@ -55,7 +71,19 @@ impl Shading {
             materials,
             lights,
             light_count,
-            environment: scene.environment,
+            environment: match &scene.environment {
+                Environment::Constant(radiance) => *radiance,
+                Environment::Map(_) => Vec3::ZERO,
+            },
+            environment_map: match &scene.environment {
+                Environment::Constant(_) => None,
+                Environment::Map(map) => Some(MapPlacement {
+                    width: map.image.width,
+                    height: map.image.height,
+                    scale: map.strength * texel_scale(map.image.max),
+                    rotation: map.rotation_deg.to_radians(),
+                }),
+            },
         }
     }
 }

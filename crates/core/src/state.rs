@@ -77,6 +77,9 @@ impl Fingerprint {
             bytemuck::cast_slice(&shading.lights),
             bytemuck::cast_slice(&counts),
             bytemuck::cast_slice(&shading.environment.to_array()),
+            bytemuck::cast_slice(&scene.environment.texels),
+            bytemuck::cast_slice(&scene.environment.distribution),
+            format!("{:?}", shading.environment_map).as_bytes(),
         ]);
         let gpu_camera = GpuCamera::new(camera);
         Self {

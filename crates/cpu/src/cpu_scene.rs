@@ -30,6 +30,10 @@ pub struct CpuScene<'a> {
     pub textures: &'a [GpuTextureInfo],
     /// Texels (WGSL `texels`).
     pub texels: &'a [u32],
+    /// The environment map's RGB9E5 texels (WGSL `env_texels`).
+    pub env_texels: &'a [u32],
+    /// The environment map's sampling distribution (WGSL `env_distribution`).
+    pub env_distribution: &'a [f32],
     /// Per object: a quad's unit normal and area; zero for other kinds.
     quads: Vec<(Vec3A, f32)>,
 }
@@ -57,6 +61,8 @@ impl<'a> CpuScene<'a> {
             lights: &scene.shading.lights,
             textures: &scene.textures.infos,
             texels: &scene.textures.texels,
+            env_texels: &scene.environment.texels,
+            env_distribution: &scene.environment.distribution,
             quads,
         }
     }

@@ -8,6 +8,7 @@ use crate::bsdf::{eval_bsdf, has_continuous_lobe, sample_bsdf};
 use crate::bvh::{Hit, Tracer};
 use crate::camera::camera_ray;
 use crate::cpu_scene::CpuScene;
+use crate::environment::env_radiance;
 use crate::intersect::Ray;
 use crate::lights::{LightSample, env_pdf, light_pdf, sample_light};
 use crate::sampler::{Draw, Sampler};
@@ -133,10 +134,11 @@ impl Path {
             } else {
                 power_heuristic(
                     self.prev_pdf,
-                    env_pdf(params, self.prev_normal, ray.dir.into()),
+                    env_pdf(scene, params, self.prev_normal, ray.dir.into()),
                 )
             };
-            self.sample.radiance += self.throughput * Vec3A::from(params.environment) * w;
+            self.sample.radiance +=
+                self.throughput * env_radiance(scene, params, ray.dir.into()) * w;
             self.alive = false;
             return None;
         };

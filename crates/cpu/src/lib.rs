@@ -10,6 +10,7 @@ pub mod bvh;
 pub mod camera;
 pub mod cpu_scene;
 pub mod display;
+pub mod environment;
 pub mod integrator;
 pub mod intersect;
 pub mod lights;

@@ -1,10 +1,11 @@
 //! Next-event estimation: choosing a light and a point on it, and the density of doing so.
 //! Twin of `lights.wgsl`.
 //!
-//! The environment is chosen with probability `env_pmf`, its directions cosine-weighted
-//! about the shading normal (for a constant environment that is the ideal density at a
-//! diffuse point); otherwise a shape light by power from the table. Quads, cylinders and triangles are sampled by area,
-//! spheres by the solid angle they subtend (uniform in the cone) from outside.
+//! The environment is chosen with probability `env_pmf`, its directions from its map's
+//! distribution or, for a constant environment, cosine-weighted about the shading normal
+//! (the ideal density at a diffuse point); otherwise a shape light by power from the table.
+//! Quads, cylinders and triangles are sampled by area, spheres by the solid angle they
+//! subtend (uniform in the cone) from outside.
 
 use std::f32::consts::{PI, TAU};
 
@@ -15,6 +16,7 @@ use pathlight_core::gpu_types::{
 use pathlight_core::light_table;
 
 use crate::cpu_scene::CpuScene;
+use crate::environment::{env_map_pdf, env_radiance, has_env_map, sample_env_map};
 use crate::intersect::{MISS, Ray, intersect_sphere};
 use crate::sampling::{
     Frame, sample_cosine_hemisphere, sample_disk, sample_uniform_sphere, sin_cos_turns,
@@ -49,7 +51,10 @@ const INVALID: LightSample = LightSample {
 /// Density of choosing the environment and direction `wi` from a point with normal `n`
 /// (on the side light is gathered from). Twin of WGSL `env_pdf`.
 #[inline(always)]
-pub fn env_pdf(params: &GpuRenderParams, n: Vec3A, wi: Vec3A) -> f32 {
+pub fn env_pdf(scene: &CpuScene, params: &GpuRenderParams, n: Vec3A, wi: Vec3A) -> f32 {
+    if has_env_map(params) {
+        return params.env_pmf * env_map_pdf(scene, params, wi);
+    }
     params.env_pmf * n.dot(wi).max(0.0) / PI
 }
 
@@ -208,9 +213,21 @@ pub fn sample_light(
     u: Vec2,
 ) -> LightSample {
     if u_select < params.env_pmf {
+        if has_env_map(params) {
+            let (wi, pdf) = sample_env_map(cpu_scene, params, u);
+            let pdf = params.env_pmf * pdf;
+            return LightSample {
+                wi,
+                point: Vec3A::ZERO,
+                finite: false,
+                radiance: env_radiance(cpu_scene, params, wi),
+                pdf,
+                valid: pdf > 0.0 && pdf.is_finite(),
+            };
+        }
         let wi = Frame::around(n).to_world(sample_cosine_hemisphere(u));
         let radiance = Vec3A::from(params.environment);
-        let pdf = env_pdf(params, n, wi);
+        let pdf = env_pdf(cpu_scene, params, n, wi);
         return LightSample {
             wi,
             point: Vec3A::ZERO,

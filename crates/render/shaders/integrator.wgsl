@@ -137,7 +137,7 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
             if !prev_delta {
                 w = power_heuristic(prev_pdf, env_pdf(prev_normal, ray.dir));
             }
-            radiance += throughput * params.environment * w;
+            radiance += throughput * env_radiance(ray.dir) * w;
             break;
         }
         let s = surface_at(hit, ray);

@@ -1,13 +1,14 @@
 // Next-event estimation: choosing a light and a point on it, and the density of doing so.
 // CPU twin: `crates/cpu/src/lights.rs`. The environment is chosen with probability
-// env_pmf, directions cosine-weighted about the shading normal; otherwise a shape light by
-// power from `lights`. Quads,
-// cylinders and triangles are sampled by area, spheres by solid angle from outside.
+// env_pmf, directions from its map's distribution or, for a constant environment,
+// cosine-weighted about the shading normal; otherwise a shape light by power from `lights`.
+// Quads, cylinders and triangles are sampled by area, spheres by solid angle from outside.
 
 #import scene
 #import params
 #import intersect
 #import sampling
+#import environment
 
 // CPU twin: `LightSample`.
 struct LightSample {
@@ -29,6 +30,9 @@ fn invalid_light_sample() -> LightSample {
 // n: the normal on the side light is gathered from.
 // CPU twin: `env_pdf`.
 fn env_pdf(n: vec3f, wi: vec3f) -> f32 {
+    if has_env_map() {
+        return params.env_pmf * env_map_pdf(wi);
+    }
     return params.env_pmf * max(0.0, dot(n, wi)) / PI;
 }
 
@@ -166,6 +170,11 @@ fn sample_shape(o: Object, primitive: u32, p: vec3f, u: vec2f, u_part: f32) -> S
 // CPU twin: `sample_light`.
 fn sample_light(p: vec3f, n: vec3f, u_select: f32, u: vec2f) -> LightSample {
     if u_select < params.env_pmf {
+        if has_env_map() {
+            let es = sample_env_map(u);
+            let pdf = params.env_pmf * es.pdf;
+            return LightSample(es.wi, vec3f(0.0), false, env_radiance(es.wi), pdf, pdf > 0.0 && pdf <= 3.0e38);
+        }
         let wi = frame_around(n) * sample_cosine_hemisphere(u);
         let pdf = env_pdf(n, wi);
         return LightSample(wi, vec3f(0.0), false, params.environment, pdf, pdf > 0.0);

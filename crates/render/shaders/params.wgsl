@@ -6,10 +6,12 @@
 // The eye and the image plane at unit distance: a point at normalised device coordinates
 // (x, y) in [-1, 1] lies along forward + x right + y up. Host: `GpuCamera`.
 struct CameraParams {
+    // The lens centre; the lens radius (0: a pinhole).
     position: vec3f,
-    pad0: u32,
+    lens_radius: f32,
+    // The plane in focus lies at `focus_distance` along `forward`.
     forward: vec3f,
-    pad1: u32,
+    focus_distance: f32,
     // Scaled to half the image width at unit distance.
     right: vec3f,
     pad2: u32,
@@ -39,6 +41,14 @@ struct RenderParams {
     sampler: u32,
     object_count: u32,
     light_count: u32,
+    // Environment map size (width 0: none), the factor from decoded texels to radiance, and
+    // the cosine and sine of its turn about +y.
+    env_width: u32,
+    env_height: u32,
+    env_scale: f32,
+    pad0: u32,
+    env_rotation: vec2f,
+    pad1: vec2u,
 }
 
 // A read-only storage buffer, not a uniform: on lavapipe (Mesa 22.3, measured) every

@@ -1,9 +1,10 @@
 //! The prepared scene on the device: bind group 0 of every ray-casting pass
-//! (`shaders/scene.wgsl`). The geometry and the textures are uploaded once; the shading
+//! (`shaders/scene.wgsl`, `shaders/environment.wgsl`). The geometry, the textures and the
+//! environment map are uploaded once; the shading
 //! (objects with their materials, materials, light table) is uploaded again when it changes.
 
 use pathlight_core::gpu_types::GpuPrimitive;
-use pathlight_core::{Geometry, PreparedScene, RenderError, Shading, Textures};
+use pathlight_core::{EnvironmentData, Geometry, PreparedScene, RenderError, Shading, Textures};
 use wgpu::util::DeviceExt;
 
 use crate::pipeline::{bind_buffers, storage_entry};
@@ -12,8 +13,8 @@ use crate::pipeline::{bind_buffers, storage_entry};
 /// (`LEAF` in `shaders/bvh.wgsl`).
 const MAX_NODES: usize = 1 << 28;
 
-/// Bindings of `scene.wgsl`, by number.
-const BINDINGS: usize = 9;
+/// Bindings of `scene.wgsl` and `environment.wgsl`, by number.
+const BINDINGS: usize = 11;
 
 /// The scene's buffers on the device and the bind group over them.
 #[derive(Debug)]
@@ -82,6 +83,22 @@ fn texture_contents(textures: &Textures) -> [(usize, &'static str, &[u8]); 2] {
     ]
 }
 
+/// The environment map's buffers: bindings 9 (texels) and 10 (distribution).
+fn environment_contents(environment: &EnvironmentData) -> [(usize, &'static str, &[u8]); 2] {
+    [
+        (
+            9,
+            "environment map",
+            bytemuck::cast_slice(&environment.texels),
+        ),
+        (
+            10,
+            "environment map distribution",
+            bytemuck::cast_slice(&environment.distribution),
+        ),
+    ]
+}
+
 /// The shading buffers: bindings 1 (objects), 3 (materials) and 6 (lights).
 fn shading_contents(shading: &Shading) -> [(usize, &'static str, &[u8]); 3] {
     [
@@ -103,8 +120,14 @@ impl SceneBuffers {
         let mut slots: Vec<Option<wgpu::Buffer>> = (0..BINDINGS).map(|_| None).collect();
         let geometry = geometry_contents(&scene.geometry);
         let textures = texture_contents(&scene.textures);
+        let environment = environment_contents(&scene.environment);
         let shading = shading_contents(&scene.shading);
-        for (binding, label, bytes) in geometry.into_iter().chain(textures).chain(shading) {
+        for (binding, label, bytes) in geometry
+            .into_iter()
+            .chain(textures)
+            .chain(environment)
+            .chain(shading)
+        {
             slots[binding] = Some(storage_buffer(device, label, bytes)?);
         }
         let buffers: Vec<wgpu::Buffer> = slots.into_iter().flatten().collect();

@@ -13,7 +13,7 @@
 use std::fmt::Write as _;
 
 /// Every WGSL file of the crate, by the name imports use.
-pub const FILES: [(&str, &str); 12] = [
+pub const FILES: [(&str, &str); 13] = [
     ("scene", include_str!("../shaders/scene.wgsl")),
     ("intersect", include_str!("../shaders/intersect.wgsl")),
     ("bvh", include_str!("../shaders/bvh.wgsl")),
@@ -23,6 +23,7 @@ pub const FILES: [(&str, &str); 12] = [
     ("camera", include_str!("../shaders/camera.wgsl")),
     ("surface", include_str!("../shaders/surface.wgsl")),
     ("bsdf", include_str!("../shaders/bsdf.wgsl")),
+    ("environment", include_str!("../shaders/environment.wgsl")),
     ("lights", include_str!("../shaders/lights.wgsl")),
     ("integrator", include_str!("../shaders/integrator.wgsl")),
     ("display", include_str!("../shaders/display.wgsl")),

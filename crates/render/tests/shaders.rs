@@ -159,7 +159,16 @@ fn host_structs_match_their_wgsl_declarations() {
         m,
         "CameraParams",
         GpuCamera,
-        [position, pad0, forward, pad1, right, pad2, up, pad3]
+        [
+            position,
+            lens_radius,
+            forward,
+            focus_distance,
+            right,
+            pad2,
+            up,
+            pad3
+        ]
     );
     assert_layout!(
         m,
@@ -180,7 +189,13 @@ fn host_structs_match_their_wgsl_declarations() {
             seed,
             sampler,
             object_count,
-            light_count
+            light_count,
+            env_width,
+            env_height,
+            env_scale,
+            pad0,
+            env_rotation,
+            pad1
         ]
     );
     assert_layout!(m, "AccumPixel", GpuAccumPixel, [hi, lo]);

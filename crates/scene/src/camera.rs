@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 
-/// A pinhole camera and the image it makes.
+/// A pinhole or thin-lens camera and the image it makes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Camera {
     /// Eye position.
@@ -17,4 +17,16 @@ pub struct Camera {
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
+    /// Radius of the lens, sampled uniformly over its disk (Mitsuba's `thinlens`); 0 is a
+    /// pinhole.
+    pub aperture_radius: f32,
+    /// Distance along the view direction of the plane in focus (> 0).
+    pub focus_distance: f32,
+}
+
+impl Camera {
+    /// The distance from the eye to the point looked at: the default focus distance.
+    pub fn look_distance(&self) -> f32 {
+        self.position.distance(self.look_at)
+    }
 }

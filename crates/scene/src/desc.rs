@@ -55,7 +55,7 @@ pub enum ColorSpace {
     Linear,
 }
 
-/// A pinhole camera.
+/// A pinhole or thin-lens camera.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraDesc {
@@ -73,6 +73,11 @@ pub struct CameraDesc {
     /// Image size in pixels, `[width, height]`.
     #[serde(default = "default_resolution", deserialize_with = "exact::array")]
     pub resolution: [u32; 2],
+    /// Radius of the lens (Mitsuba's thin lens); 0, the default, is a pinhole.
+    #[serde(default)]
+    pub aperture_radius: f32,
+    /// Distance along the view direction of the plane in focus; default: to `look_at`.
+    pub focus_distance: Option<f32>,
 }
 
 fn default_up() -> [f32; 3] {
@@ -122,13 +127,20 @@ impl Default for RenderDesc {
     }
 }
 
-/// Constant radiance arriving from every direction.
+/// Light arriving from every direction: a constant radiance or an equirectangular HDR map.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EnvironmentDesc {
-    /// Linear RGB radiance.
-    #[serde(deserialize_with = "exact::array")]
-    pub radiance: [f32; 3],
+    /// Constant linear RGB radiance (instead of `map`).
+    #[serde(default, deserialize_with = "exact::optional_array")]
+    pub radiance: Option<[f32; 3]>,
+    /// Equirectangular map (`.exr`, `.hdr`), relative to the scene file (instead of
+    /// `radiance`).
+    pub map: Option<String>,
+    /// Factor on the map's texels.
+    pub strength: Option<f32>,
+    /// Turn of the map about the up (+y) axis, degrees.
+    pub rotation: Option<f32>,
 }
 
 /// A material: the seed's parameters plus emission and conductors.

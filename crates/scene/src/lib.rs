@@ -5,6 +5,7 @@
 pub mod camera;
 pub mod default_scene;
 pub mod desc;
+pub mod environment;
 pub mod error;
 mod exact;
 pub mod load;
@@ -17,9 +18,8 @@ pub mod shape;
 pub mod testing;
 pub mod texture;
 
-use glam::Vec3;
-
 pub use camera::Camera;
+pub use environment::{Environment, EnvironmentMap, HdrImage};
 pub use error::{RangeError, SceneError};
 pub use load::{SceneSource, load_scene, load_scene_file};
 pub use material::{Conductor, Lobes, Material};
@@ -35,8 +35,8 @@ pub struct Scene {
     pub camera: Camera,
     /// Sampling settings.
     pub settings: RenderSettings,
-    /// Constant environment radiance (black when there is none).
-    pub environment: Vec3,
+    /// Light arriving from infinitely far away.
+    pub environment: Environment,
     /// Materials.
     pub materials: Vec<Material>,
     /// Textures referenced by materials.

@@ -3,18 +3,21 @@
 use std::collections::HashMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 use toml::Spanned;
 
-use crate::desc::{ColorSpace, MaterialDesc, RenderDesc, SamplerDesc, SceneDesc, Shading};
+use crate::desc::{
+    ColorSpace, EnvironmentDesc, MaterialDesc, RenderDesc, SamplerDesc, SceneDesc, Shading,
+};
 use crate::error::SceneError;
 use crate::revolve::Revolution;
 use crate::settings::{MAX_COORDINATE, check_max_depth, check_resolution, check_spp};
 use crate::texture::srgb_to_linear;
 use crate::{
-    Camera, Conductor, Lobes, Material, Object, RenderSettings, Sampler, Scene, Shape, Texture,
-    TriangleMesh,
+    Camera, Conductor, Environment, HdrImage, Lobes, Material, Object, RenderSettings, Sampler,
+    Scene, Shape, Texture, TriangleMesh,
 };
 
 /// Where a scene's text and assets come from.
@@ -93,10 +96,8 @@ impl Builder<'_, '_> {
         let camera = self.camera(&desc)?;
         let settings = self.settings(&desc)?;
         let environment = match &desc.environment {
-            None => Vec3::ZERO,
-            Some(env) => {
-                self.radiance(env.span(), "environment.radiance", env.get_ref().radiance)?
-            }
+            None => Environment::default(),
+            Some(env) => self.environment(env)?,
         };
         let mut materials = Vec::new();
         let mut material_ids = HashMap::new();
@@ -137,7 +138,20 @@ impl Builder<'_, '_> {
             ));
         }
         let [width, height] = c.resolution;
-        check_resolution(width, height).map_err(|e| self.invalid(span, e.to_string()))?;
+        check_resolution(width, height).map_err(|e| self.invalid(span.clone(), e.to_string()))?;
+        if !(c.aperture_radius >= 0.0 && c.aperture_radius <= MAX_COORDINATE) {
+            return Err(self.invalid(
+                span,
+                format!(
+                    "camera.aperture_radius = {} must be >= 0 and at most {MAX_COORDINATE:e}",
+                    c.aperture_radius
+                ),
+            ));
+        }
+        let focus_distance = match c.focus_distance {
+            Some(d) => self.length(span, "camera.focus_distance", d)?,
+            None => position.distance(look_at),
+        };
         Ok(Camera {
             position,
             look_at,
@@ -145,7 +159,60 @@ impl Builder<'_, '_> {
             fov_y_deg: c.fov_y,
             width,
             height,
+            aperture_radius: c.aperture_radius,
+            focus_distance,
         })
+    }
+
+    /// `[environment]`: a constant `radiance` or a `map` with its `strength` and `rotation`.
+    fn environment(&self, env: &Spanned<EnvironmentDesc>) -> Result<Environment, SceneError> {
+        let (span, e) = (env.span(), env.get_ref());
+        let key = |k: &str| format!("environment.{k}");
+        match (&e.radiance, &e.map) {
+            (Some(radiance), None) => {
+                if e.strength.is_some() || e.rotation.is_some() {
+                    return Err(self.invalid(
+                        span,
+                        "environment.strength and environment.rotation apply to a `map`".into(),
+                    ));
+                }
+                Ok(Environment::Constant(self.radiance(
+                    span,
+                    &key("radiance"),
+                    *radiance,
+                )?))
+            }
+            (None, Some(path)) => {
+                let strength = e.strength.unwrap_or(1.0);
+                if !(strength.is_finite() && strength >= 0.0) {
+                    return Err(self.invalid(
+                        span,
+                        format!("{} = {strength} must be finite and >= 0", key("strength")),
+                    ));
+                }
+                let rotation = e.rotation.unwrap_or(0.0);
+                if !rotation.is_finite() {
+                    return Err(self.invalid(
+                        span,
+                        format!("{} = {rotation} must be finite", key("rotation")),
+                    ));
+                }
+                let (full, bytes) = self.asset_bytes(path).map_err(|err| match err {
+                    SceneError::Io { path, source } => self.invalid(
+                        span.clone(),
+                        format!("{}: cannot read {}: {source}", key("map"), path.display()),
+                    ),
+                    other => other,
+                })?;
+                let image = HdrImage::decode(&bytes, &full)?;
+                Ok(Environment::from_map(Arc::new(image), strength, rotation))
+            }
+            _ => Err(self.invalid(
+                span,
+                "[environment] needs exactly one of `radiance` (a constant) and `map` (an image)"
+                    .into(),
+            )),
+        }
     }
 
     fn settings(&self, desc: &SceneDesc) -> Result<RenderSettings, SceneError> {

@@ -5,7 +5,10 @@ use glam::{Vec2, Vec3};
 use rand::Rng;
 use rand::rngs::StdRng;
 
-use crate::{Camera, Lobes, Material, Object, RenderSettings, Sampler, Scene, Shape, TriangleMesh};
+use crate::{
+    Camera, Environment, Lobes, Material, Object, RenderSettings, Sampler, Scene, Shape,
+    TriangleMesh,
+};
 
 /// A scene of `objects` in one grey diffuse material (index 0), seen from +z by an 8x8
 /// camera, with default settings.
@@ -18,6 +21,8 @@ pub fn scene_of(objects: Vec<Object>) -> Scene {
             fov_y_deg: 40.0,
             width: 8,
             height: 8,
+            aperture_radius: 0.0,
+            focus_distance: 1.0,
         },
         settings: RenderSettings {
             spp: 1,
@@ -26,7 +31,7 @@ pub fn scene_of(objects: Vec<Object>) -> Scene {
             seed: 0,
             sampler: Sampler::Sobol,
         },
-        environment: Vec3::ZERO,
+        environment: Environment::default(),
         materials: vec![Material {
             name: "grey".into(),
             base_color: Vec3::splat(0.5),

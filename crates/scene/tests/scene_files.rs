@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use pathlight_scene::settings::{MAX_RESOLUTION, MAX_SPP};
 use pathlight_scene::{
-    Scene, SceneError, SceneSource, Shape, default_scene, load_scene, load_scene_file,
+    Environment, Scene, SceneError, SceneSource, Shape, default_scene, load_scene, load_scene_file,
 };
 
 fn repo() -> PathBuf {
@@ -49,8 +49,8 @@ fn shipped_scenes_load() {
         }
     }
     assert_eq!(
-        found, 20,
-        "default + six reference scenes + 13 furnace rings"
+        found, 23,
+        "default + outdoor + eight reference scenes + 13 furnace rings"
     );
 }
 
@@ -315,4 +315,92 @@ fn extra_elements_bad_rotations_and_duplicate_names_are_refused() {
         message.contains("\"ball\"") && message.contains("line"),
         "{message}"
     );
+}
+
+#[test]
+fn environment_maps_load_with_strength_and_rotation() {
+    let scene = load("[environment]\nmap = \"sky.exr\"\nstrength = 2\nrotation = -30\n").unwrap();
+    let Environment::Map(map) = &scene.environment else {
+        panic!("{:?}", scene.environment);
+    };
+    assert_eq!((map.image.width, map.image.height), (4, 3));
+    assert_eq!((map.strength, map.rotation_deg), (2.0, -30.0));
+    // Row 1, column 2 of the file: x 0.1 + y.
+    assert_eq!(map.image.texels[4 + 2], [1.2, 0.5, 0.25]);
+    // A map of equal texels is the constant environment it equals.
+    let scene = load("[environment]\nmap = \"constant.exr\"\nstrength = 4\n").unwrap();
+    assert_eq!(
+        scene.environment,
+        Environment::Constant(glam::Vec3::new(2.0, 1.0, 0.5))
+    );
+}
+
+#[test]
+fn bad_environments_and_lenses_are_refused_with_line_or_texel() {
+    for (body, wanted) in [
+        (
+            "[environment]\nmap = \"no-such.exr\"\n",
+            "test.toml:6: environment.map: cannot read",
+        ),
+        (
+            "[environment]\nmap = \"tetra.obj\"\n",
+            "tetra.obj: cannot decode image",
+        ),
+        (
+            "[environment]\nmap = \"nan.exr\"\n",
+            "nan.exr: texel (2, 1) holds NaN",
+        ),
+        (
+            "[environment]\nmap = \"inf.exr\"\n",
+            "inf.exr: texel (3, 2) holds inf",
+        ),
+        (
+            "[environment]\nradiance = [1, 1, 1]\nmap = \"sky.exr\"\n",
+            "test.toml:6: [environment] needs exactly one of",
+        ),
+        (
+            "[environment]\n",
+            "test.toml:6: [environment] needs exactly one of",
+        ),
+        (
+            "[environment]\nmap = \"sky.exr\"\nstrength = -1\n",
+            "environment.strength = -1 must be finite and >= 0",
+        ),
+        (
+            "[environment]\nradiance = [1, 1, 1]\nrotation = 3\n",
+            "apply to a `map`",
+        ),
+    ] {
+        let message = error(body);
+        assert!(message.contains(wanted), "{body:?}: {message}");
+    }
+    let lens = |keys: &str| {
+        let text =
+            format!("[camera]\nposition = [0, 0, 3]\nlook_at = [0, 0, 0]\nfov_y = 40\n{keys}\n");
+        load_scene(&SceneSource {
+            name: "lens.toml".into(),
+            text: &text,
+            base_dir: data(),
+            embedded: &[],
+        })
+    };
+    for (keys, wanted) in [
+        (
+            "aperture_radius = -0.1",
+            "lens.toml:1: camera.aperture_radius = -0.1 must be >= 0",
+        ),
+        (
+            "focus_distance = 0",
+            "lens.toml:1: camera.focus_distance = 0 must be > 0",
+        ),
+        (
+            "focus_distance = -2",
+            "camera.focus_distance = -2 must be > 0",
+        ),
+    ] {
+        let message = lens(keys).unwrap_err().to_string();
+        assert!(message.contains(wanted), "{keys}: {message}");
+    }
+    let camera = lens("aperture_radius = 0.1").unwrap().camera;
+    assert_eq!((camera.aperture_radius, camera.focus_distance), (0.1, 3.0));
 }

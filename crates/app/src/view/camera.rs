@@ -97,9 +97,43 @@ impl Orbit {
     }
 }
 
+/// Smallest lens the viewer opens, as a fraction of the focus distance: `]` on a pinhole
+/// opens to it, `[` below it closes to a pinhole.
+const SMALLEST_APERTURE: f32 = 0.005;
+
+/// The aperture radius after opening (`factor` > 1) or closing (< 1) `camera`'s lens.
+pub fn next_aperture(camera: &Camera, factor: f32) -> f32 {
+    let smallest = SMALLEST_APERTURE * camera.focus_distance;
+    let radius = camera.aperture_radius * factor;
+    if factor > 1.0 {
+        radius.max(smallest)
+    } else if radius < smallest * 0.999 {
+        0.0
+    } else {
+        radius
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn brackets_open_a_pinhole_step_by_step_and_close_it_again() {
+        let mut c = camera();
+        let mut radii = Vec::new();
+        for _ in 0..3 {
+            c.aperture_radius = next_aperture(&c, 1.5);
+            radii.push(c.aperture_radius);
+        }
+        assert!((radii[0] - 0.025).abs() < 1e-7 && (radii[2] - 0.025 * 2.25).abs() < 1e-6);
+        for _ in 0..2 {
+            c.aperture_radius = next_aperture(&c, 1.0 / 1.5);
+        }
+        assert!((c.aperture_radius - 0.025).abs() < 1e-6);
+        c.aperture_radius = next_aperture(&c, 1.0 / 1.5);
+        assert_eq!(c.aperture_radius, 0.0);
+    }
 
     fn camera() -> Camera {
         Camera {
@@ -109,6 +143,8 @@ mod tests {
             fov_y_deg: 40.0,
             width: 500,
             height: 500,
+            aperture_radius: 0.0,
+            focus_distance: 5.0,
         }
     }
 

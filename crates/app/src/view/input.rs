@@ -24,6 +24,10 @@ pub enum Action {
     NextIteration,
     /// Toggle the object under this window point between light and material (left click).
     Click(PhysicalPosition<f64>),
+    /// Focus the lens on the surface under this window point (`F`, or ctrl + left click).
+    Focus(PhysicalPosition<f64>),
+    /// Open (> 1) or close (< 1) the lens by this factor (`]`, `[`).
+    Aperture(f32),
     /// Orbit by this many pixels dragged (left drag).
     Orbit(f32, f32),
     /// Pan by this many pixels dragged (middle drag, or shift + left drag).
@@ -93,30 +97,50 @@ impl Pointer {
                 let was_click = !self.dragging && self.pressed_at.is_some();
                 self.pressed_at = None;
                 self.dragging = false;
-                (was_click && button == MouseButton::Left).then_some(Action::Click(self.position))
+                if !was_click || button != MouseButton::Left {
+                    return None;
+                }
+                Some(if self.modifiers.control_key() {
+                    Action::Focus(self.position)
+                } else {
+                    Action::Click(self.position)
+                })
             }
             MouseButton::Right if pressed => Some(Action::NextIteration),
             _ => None,
         }
     }
+
+    /// Where the pointer is.
+    pub fn position(&self) -> PhysicalPosition<f64> {
+        self.position
+    }
 }
 
-/// The action of a key press (repeats and releases do nothing).
-pub fn key_action(event: &KeyEvent) -> Option<Action> {
-    if event.state != ElementState::Pressed || event.repeat {
+/// Factor by which `]` opens and `[` closes the lens.
+pub const APERTURE_STEP: f32 = 1.5;
+
+/// The action of a key press with the pointer at `pointer` (releases do nothing; `[` and `]`
+/// repeat while held, other keys do not).
+pub fn key_action(event: &KeyEvent, pointer: PhysicalPosition<f64>) -> Option<Action> {
+    if event.state != ElementState::Pressed {
         return None;
     }
-    match &event.logical_key {
-        Key::Named(NamedKey::Escape) => Some(Action::Quit),
-        Key::Named(NamedKey::Space) => Some(Action::TogglePause),
+    let action = match &event.logical_key {
+        Key::Named(NamedKey::Escape) => Action::Quit,
+        Key::Named(NamedKey::Space) => Action::TogglePause,
         Key::Character(c) => match c.to_lowercase().as_str() {
-            "s" => Some(Action::Save),
-            "r" => Some(Action::Restart),
-            "t" => Some(Action::CycleTonemap),
-            _ => None,
+            "s" => Action::Save,
+            "r" => Action::Restart,
+            "t" => Action::CycleTonemap,
+            "f" => Action::Focus(pointer),
+            "]" => Action::Aperture(APERTURE_STEP),
+            "[" => Action::Aperture(1.0 / APERTURE_STEP),
+            _ => return None,
         },
-        _ => None,
-    }
+        _ => return None,
+    };
+    (!event.repeat || matches!(action, Action::Aperture(_))).then_some(action)
 }
 
 /// The zoom of a wheel turn, in steps.

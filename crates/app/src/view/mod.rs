@@ -44,7 +44,7 @@ use winit::window::WindowId;
 use crate::backend::load_scene;
 use crate::cli::{DeviceArgs, ViewArgs};
 use crate::output;
-use camera::Orbit;
+use camera::{Orbit, next_aperture};
 use input::{Action, Pointer, key_action, wheel_action};
 use iterations::{Iterations, Phase};
 use picking::{LightSwitch, pick};
@@ -299,10 +299,11 @@ impl Viewer {
         let (width, height) = (self.scene.camera.width, self.scene.camera.height);
         let x = at.x as f32 * width as f32 / size.width.max(1) as f32;
         let y = at.y as f32 * height as f32 / size.height.max(1) as f32;
-        let Some(object) = pick(&self.scene, &self.prepared, x, y) else {
+        let Some(picked) = pick(&self.scene, &self.prepared, x, y) else {
             say!("picked nothing");
             return Ok(());
         };
+        let object = picked.object;
         let on = self.lights.toggle(&mut self.scene, object);
         say!(
             "picked {}: light {}",
@@ -313,6 +314,34 @@ impl Viewer {
         window.frames.set_materials(&self.prepared.shading)?;
         self.restarted();
         Ok(())
+    }
+
+    /// Focuses the lens on the surface under window point `at`.
+    fn focus(&mut self, at: PhysicalPosition<f64>) -> anyhow::Result<()> {
+        let Some(window) = &self.window else {
+            return Ok(());
+        };
+        let size = window.window.inner_size();
+        let (width, height) = (self.scene.camera.width, self.scene.camera.height);
+        let x = at.x as f32 * width as f32 / size.width.max(1) as f32;
+        let y = at.y as f32 * height as f32 / size.height.max(1) as f32;
+        let Some(picked) = pick(&self.scene, &self.prepared, x, y) else {
+            say!("nothing to focus on");
+            return Ok(());
+        };
+        self.scene.camera.focus_distance = picked.depth;
+        say!(
+            "focused on {} at distance {}",
+            self.scene.objects[picked.object].name,
+            picked.depth
+        );
+        self.lens_changed()
+    }
+
+    /// Starts the image over with the scene camera's new lens.
+    fn lens_changed(&mut self) -> anyhow::Result<()> {
+        let camera = self.scene.camera.clone();
+        self.set_camera(&camera, false)
     }
 
     fn act(&mut self, event_loop: &ActiveEventLoop, action: Action) -> anyhow::Result<()> {
@@ -341,6 +370,13 @@ impl Viewer {
                 }
             }
             Action::Click(at) => self.click(at)?,
+            Action::Focus(at) => self.focus(at)?,
+            Action::Aperture(factor) => {
+                let camera = &mut self.scene.camera;
+                camera.aperture_radius = next_aperture(camera, factor);
+                say!("aperture radius {}", camera.aperture_radius);
+                self.lens_changed()?;
+            }
             Action::Orbit(dx, dy) => {
                 self.orbit.orbit(dx, dy);
                 self.camera_changed()?;
@@ -389,7 +425,7 @@ impl Viewer {
                 self.redraw()?;
                 None
             }
-            WindowEvent::KeyboardInput { event, .. } => key_action(&event),
+            WindowEvent::KeyboardInput { event, .. } => key_action(&event, self.pointer.position()),
             WindowEvent::ModifiersChanged(modifiers) => {
                 self.pointer.set_modifiers(modifiers.state());
                 None

@@ -14,14 +14,27 @@ use pathlight_scene::Scene;
 /// Emission strength when the scene has no emitter to compare with.
 const FALLBACK_STRENGTH: f32 = 10.0;
 
-/// Index into `scene.objects` of the nearest object of `prepared` (the scene prepared)
-/// under image point (x, y) (pixels from the top-left corner, fractions allowed), if any.
-pub fn pick(scene: &Scene, prepared: &PreparedScene, x: f32, y: f32) -> Option<usize> {
+/// The nearest surface under a point of the image.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Picked {
+    /// Index into `scene.objects`.
+    pub object: usize,
+    /// Distance of the hit point from the eye along the view direction (a focus distance).
+    pub depth: f32,
+}
+
+/// The nearest object of `prepared` (the scene prepared) under image point (x, y) (pixels
+/// from the top-left corner, fractions allowed) seen through the pinhole at the lens
+/// centre, if any.
+pub fn pick(scene: &Scene, prepared: &PreparedScene, x: f32, y: f32) -> Option<Picked> {
     let params = GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
     let ray = primary_ray(&params, Vec2::new(x, y));
     let view = CpuScene::new(prepared);
     let hit = Tracer::new(&view).intersect(&ray, 1e30)?;
-    Some(hit.object as usize)
+    Some(Picked {
+        object: hit.object as usize,
+        depth: hit.t * ray.dir.dot(Vec3::from(params.camera.forward)),
+    })
 }
 
 /// Turns objects into lights and back, remembering each one's own material.
@@ -116,11 +129,13 @@ mod tests {
             ("glass sphere", Vec3::new(0.5, 0.33, -1.05)),
         ] {
             let (x, y) = project(&scene, centre);
-            let picked = pick(&scene, &prepared, x, y).map(|i| scene.objects[i].name.clone());
+            let picked =
+                pick(&scene, &prepared, x, y).map(|p| scene.objects[p.object].name.clone());
             assert_eq!(picked.as_deref(), Some(name), "at ({x}, {y})");
         }
         // The top-left corner sees the ceiling or a wall, never a model.
-        let corner = pick(&scene, &prepared, 0.5, 0.5).map(|i| scene.objects[i].name.clone());
+        let corner =
+            pick(&scene, &prepared, 0.5, 0.5).map(|p| scene.objects[p.object].name.clone());
         assert!(
             corner
                 .as_ref()

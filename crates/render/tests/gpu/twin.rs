@@ -6,10 +6,17 @@ use crate::common::{render, render_cpu, scene};
 
 #[test]
 fn gpu_and_cpu_render_the_same_image() {
-    for name in [
-        "refs/cornell-spheres.toml",
-        "refs/cornell-materials.toml",
-        "default.toml",
+    // Per scene: how close a pixel must be (relative, over 1 + its value). The sun of
+    // env-sun is a steep function of direction (30000 beside 10 one texel away), and the
+    // software adapter's atan2, acos, sin and cos differ from the CPU's by about 1e-4 rad
+    // there: up to 1% in the pixels it lights (0.1% seen directly); the image means agree
+    // to 1e-4.
+    for (name, tolerance) in [
+        ("refs/cornell-spheres.toml", 1e-3),
+        ("refs/cornell-materials.toml", 1e-3),
+        ("refs/env-sun.toml", 1e-2),
+        ("refs/cornell-dof.toml", 1e-3),
+        ("default.toml", 1e-3),
     ] {
         let s = scene(name, 40, 4, 2);
         let gpu = render(&s);
@@ -18,9 +25,10 @@ fn gpu_and_cpu_render_the_same_image() {
             .pixels
             .iter()
             .zip(&cpu.pixels)
-            .filter(|(g, c)| (0..3).all(|i| (g[i] - c[i]).abs() <= 1e-3 * (1.0 + c[i].abs())))
+            .filter(|(g, c)| (0..3).all(|i| (g[i] - c[i]).abs() <= tolerance * (1.0 + c[i].abs())))
             .count();
-        // Measured at 40x40, 4 spp: 1600, 1600 and 1596 of 1600 pixels agree.
+        // Measured at 40x40, 4 spp: 1600, 1600, 1600, 1600 and 1595 of 1600 pixels agree.
+        println!("{name}: {close} of {} pixels agree", gpu.pixels.len());
         assert!(
             close * 100 >= 99 * gpu.pixels.len(),
             "{name}: only {close} of {} pixels agree",
