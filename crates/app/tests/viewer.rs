@@ -350,6 +350,29 @@ fn iterates_waits_for_right_clicks_picks_saves_and_drags(backend: &str) {
     assert!((1..=64).contains(&w) && (1..=64).contains(&h), "{line}");
     viewer.wait_for("iter 1 finished", 3);
 
+    // `F` focuses the lens on the surface under the pointer, `]` opens the lens, `[` closes
+    // it again, ctrl + left click focuses too; each says so and restarts.
+    x.run("xdotool", &["mousemove", "--window", &window, "32", "32"]);
+    x.run("xdotool", &["key", "f"]);
+    let line = viewer.wait_for("focused on ", 1);
+    let depth: f32 = line.rsplit(' ').next().unwrap().parse().unwrap();
+    assert!(depth > 1.0 && depth < 5.0, "{line}");
+    x.run("xdotool", &["key", "bracketright"]);
+    let line = viewer.wait_for("aperture radius ", 1);
+    let radius: f32 = line.rsplit(' ').next().unwrap().parse().unwrap();
+    assert!((radius - 0.005 * depth).abs() < 1e-4, "{line}");
+    x.run("xdotool", &["key", "bracketleft"]);
+    assert_eq!(viewer.wait_for("aperture radius ", 2), "aperture radius 0");
+    x.run(
+        "xdotool",
+        &["keydown", "ctrl", "click", "1", "keyup", "ctrl"],
+    );
+    assert!(
+        viewer
+            .wait_for("focused on ", 2)
+            .ends_with(&format!(" {depth}"))
+    );
+
     // `Esc` quits cleanly.
     x.run("xdotool", &["key", "Escape"]);
     let started = Instant::now();

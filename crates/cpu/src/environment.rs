@@ -301,29 +301,26 @@ mod tests {
         for rotation in [0.0f32, 90.0, -30.0] {
             let (prepared, params) = sun_map(rotation);
             let scene = CpuScene::new(&prepared);
-            let (phi, theta) = (TAU * 11.5 / 16.0, std::f32::consts::PI * 0.25);
-            let local = Vec3::new(
-                theta.sin() * phi.sin(),
-                theta.cos(),
-                -theta.sin() * phi.cos(),
-            );
-            // Mitsuba's to_world rotation about +y by `rotation`.
-            let world = glam::Quat::from_rotation_y(rotation.to_radians()) * local;
-            let seen = env_radiance(&scene, &params, world.into());
+            // Radiance seen at longitude `phi` on the sun's row, turned as Mitsuba's
+            // to_world rotation about +y by `rotation` turns it.
+            let theta = std::f32::consts::PI * 0.25;
+            let seen_at = |phi: f32| {
+                let local = Vec3::new(
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                    -theta.sin() * phi.cos(),
+                );
+                let world = glam::Quat::from_rotation_y(rotation.to_radians()) * local;
+                env_radiance(&scene, &params, world.into())
+            };
+            let seen = seen_at(TAU * 11.5 / 16.0);
             let expected = Vec3A::new(500.0, 400.0, 300.0) * 2.0;
             assert!(
                 (seen - expected).abs().max_element() <= 1e-3 * 1000.0,
-                "rotation {rotation}: {seen} at {world}"
+                "rotation {rotation}: {seen}"
             );
             // Halfway to the next column the bilinear weight is one half.
-            let phi = TAU * 12.0 / 16.0;
-            let local = Vec3::new(
-                theta.sin() * phi.sin(),
-                theta.cos(),
-                -theta.sin() * phi.cos(),
-            );
-            let world = glam::Quat::from_rotation_y(rotation.to_radians()) * local;
-            let seen = env_radiance(&scene, &params, world.into());
+            let seen = seen_at(TAU * 12.0 / 16.0);
             assert!((seen.x - 500.0).abs() < 2.0, "rotation {rotation}: {seen}");
         }
         // Straight up reads the top row, straight down the black bottom one.

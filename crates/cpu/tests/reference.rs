@@ -171,6 +171,27 @@ fn cornell_dof_matches_mitsuba() {
     check_against_mitsuba("cornell-dof");
 }
 
+/// The mean of `spp` samples of pixel (x, y), each path traced alone (one ray at a time)
+/// with `params` (the image's width from them).
+fn pixel_alone(
+    tracer: &mut Tracer,
+    cpu_scene: &CpuScene,
+    params: &GpuRenderParams,
+    (x, y): (u32, u32),
+    spp: u32,
+) -> [f32; 3] {
+    let mut sum = [0.0f64; 3];
+    for i in 0..spp {
+        let sampler = Sampler::new(params.sampler, y * params.width + x, i, params.seed);
+        let path = trace_path(tracer, cpu_scene, params, x, y, sampler);
+        let value = accumulated_value(path.radiance);
+        for c in 0..3 {
+            sum[c] += f64::from(value[c]);
+        }
+    }
+    sum.map(|s| (s / f64::from(spp)) as f32)
+}
+
 /// relMSE of env-sun at 64x64, `spp`, seed `seed`, rendered path by path, with the
 /// environment map importance-sampled (next-event estimation combined with BSDF sampling by
 /// MIS) or reached by BSDF sampling alone (`env_pmf` 0: no environment samples, and escaping
@@ -196,16 +217,8 @@ fn env_sun_relmse(spp: u32, seed: u32, importance: bool) -> f64 {
     };
     for y in 0..size {
         for x in 0..size {
-            let mut sum = [0.0f64; 3];
-            for i in 0..spp {
-                let sampler = Sampler::new(params.sampler, y * size + x, i, params.seed);
-                let path = trace_path(&mut tracer, &cpu_scene, &params, x, y, sampler);
-                let value = accumulated_value(path.radiance);
-                for c in 0..3 {
-                    sum[c] += f64::from(value[c]);
-                }
-            }
-            film.pixels[(y * size + x) as usize] = sum.map(|s| (s / f64::from(spp)) as f32);
+            film.pixels[(y * size + x) as usize] =
+                pixel_alone(&mut tracer, &cpu_scene, &params, (x, y), spp);
         }
     }
     film.relmse(&Film::read_exr(&reference).unwrap().downsample(4))
@@ -309,16 +322,7 @@ fn packets_trace_each_path_as_it_is_traced_alone() {
     let mut differing = 0;
     for y in 0..size {
         for x in 0..size {
-            let mut sum = [0.0f64; 3];
-            for i in 0..spp {
-                let sampler = Sampler::new(params.sampler, y * size + x, i, params.seed);
-                let path = trace_path(&mut tracer, &cpu_scene, &params, x, y, sampler);
-                let value = accumulated_value(path.radiance);
-                for c in 0..3 {
-                    sum[c] += f64::from(value[c]);
-                }
-            }
-            let alone = sum.map(|s| (s / f64::from(spp)) as f32);
+            let alone = pixel_alone(&mut tracer, &cpu_scene, &params, (x, y), spp);
             let packed = film.pixel(x, y);
             let same = (0..3).all(|c| (alone[c] - packed[c]).abs() <= 1e-6 * alone[c].max(1.0));
             differing += usize::from(!same);

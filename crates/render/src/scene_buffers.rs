@@ -35,10 +35,12 @@ fn storage_buffer(
 ) -> Result<wgpu::Buffer, RenderError> {
     let limit = device.limits().max_storage_buffer_binding_size;
     if bytes.len() as u64 > limit {
+        let mib = |n: u64| n as f64 / f64::from(1 << 20);
         return Err(RenderError::Limits(format!(
-            "the scene's {label} take {} MiB; this device binds at most {} MiB",
-            bytes.len() >> 20,
-            limit >> 20
+            "the scene's {label} take {:.1} MiB; this device binds at most {:.1} MiB \
+             (the CPU backend, --backend cpu, has no such limit)",
+            mib(bytes.len() as u64),
+            mib(limit)
         )));
     }
     Ok(

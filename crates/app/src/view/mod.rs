@@ -47,7 +47,7 @@ use crate::output;
 use camera::{Orbit, next_aperture};
 use input::{Action, Pointer, key_action, wheel_action};
 use iterations::{Iterations, Phase};
-use picking::{LightSwitch, pick};
+use picking::{LightSwitch, Picked, pick};
 use preview::Preview;
 use title::{RayRate, Title};
 use window::ViewerWindow;
@@ -289,17 +289,22 @@ impl Viewer {
         Ok(())
     }
 
-    /// A left click at window point `at`: toggles the object there between a light and
-    /// its material, and gives the renderer the new materials.
-    fn click(&mut self, at: PhysicalPosition<f64>) -> anyhow::Result<()> {
-        let Some(window) = &mut self.window else {
-            return Ok(());
-        };
-        let size = window.window.inner_size();
+    /// The surface under window point `at` (the window's pixels scaled to the image's).
+    fn pick_at(&self, at: PhysicalPosition<f64>) -> Option<Picked> {
+        let size = self.window.as_ref()?.window.inner_size();
         let (width, height) = (self.scene.camera.width, self.scene.camera.height);
         let x = at.x as f32 * width as f32 / size.width.max(1) as f32;
         let y = at.y as f32 * height as f32 / size.height.max(1) as f32;
-        let Some(picked) = pick(&self.scene, &self.prepared, x, y) else {
+        pick(&self.scene, &self.prepared, x, y)
+    }
+
+    /// A left click at window point `at`: toggles the object there between a light and
+    /// its material, and gives the renderer the new materials.
+    fn click(&mut self, at: PhysicalPosition<f64>) -> anyhow::Result<()> {
+        if self.window.is_none() {
+            return Ok(());
+        }
+        let Some(picked) = self.pick_at(at) else {
             say!("picked nothing");
             return Ok(());
         };
@@ -311,21 +316,19 @@ impl Viewer {
             if on { "on" } else { "off" }
         );
         self.prepared.shading = self.prepared.shading_of(&self.scene);
-        window.frames.set_materials(&self.prepared.shading)?;
+        if let Some(window) = &mut self.window {
+            window.frames.set_materials(&self.prepared.shading)?;
+        }
         self.restarted();
         Ok(())
     }
 
     /// Focuses the lens on the surface under window point `at`.
     fn focus(&mut self, at: PhysicalPosition<f64>) -> anyhow::Result<()> {
-        let Some(window) = &self.window else {
+        if self.window.is_none() {
             return Ok(());
-        };
-        let size = window.window.inner_size();
-        let (width, height) = (self.scene.camera.width, self.scene.camera.height);
-        let x = at.x as f32 * width as f32 / size.width.max(1) as f32;
-        let y = at.y as f32 * height as f32 / size.height.max(1) as f32;
-        let Some(picked) = pick(&self.scene, &self.prepared, x, y) else {
+        }
+        let Some(picked) = self.pick_at(at) else {
             say!("nothing to focus on");
             return Ok(());
         };
