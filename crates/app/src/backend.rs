@@ -59,6 +59,9 @@ fn apply_environment(scene: &mut Scene, args: &SceneArgs) -> anyhow::Result<()> 
             "--env-rotation {rotation} must be finite"
         );
     }
+    if args.env.is_none() && args.env_strength.is_none() && args.env_rotation.is_none() {
+        return Ok(());
+    }
     let (image, strength, rotation) = match (&args.env, &scene.environment) {
         (Some(path), _) => (Arc::new(HdrImage::open(path)?), 1.0, 0.0),
         (None, Environment::Map(map)) => (map.image.clone(), map.strength, map.rotation_deg),

@@ -15,7 +15,10 @@
 //! per cell row the CDF over its columns (`width` values each). Each CDF ends at exactly 1;
 //! a cell's probability is the difference of its CDF value and the one before.
 
+use glam::Vec3;
 use pathlight_scene::HdrImage;
+
+use crate::light_table::luminance;
 
 /// Largest value RGB9E5 holds: (511 / 512) 2^16.
 const RGB9E5_MAX: f32 = 65408.0;
@@ -93,11 +96,6 @@ pub fn decode_rgb9e5(texel: u32) -> [f32; 3] {
     [0, 9, 18].map(|shift| ((texel >> shift) & 511) as f32 * unit)
 }
 
-/// Luminance of linear RGB (Rec. 709 weights).
-fn luminance(rgb: [f32; 3]) -> f64 {
-    0.2126 * f64::from(rgb[0]) + 0.7152 * f64::from(rgb[1]) + 0.0722 * f64::from(rgb[2])
-}
-
 /// A CDF (ending at exactly 1) of `weights`, or a uniform one when they sum to zero.
 fn cdf(weights: &[f64]) -> Vec<f32> {
     let total: f64 = weights.iter().sum();
@@ -124,7 +122,7 @@ fn build_distribution(texels: &[u32], width: u32, height: u32) -> Vec<f32> {
     let (w, h) = (width as usize, height as usize);
     let lum: Vec<f64> = texels
         .iter()
-        .map(|&t| luminance(decode_rgb9e5(t)))
+        .map(|&t| f64::from(luminance(Vec3::from(decode_rgb9e5(t)))))
         .collect();
     let cos_theta: Vec<f32> = (0..h)
         .map(|i| (std::f64::consts::PI * i as f64 / (h - 1) as f64).cos() as f32)

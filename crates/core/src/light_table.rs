@@ -12,6 +12,12 @@ use crate::gpu_types::{
     KIND_SPHERE, NO_LIGHT,
 };
 
+/// Luminance of linear RGB (Rec. 709 weights): what emitters and environment-map cells are
+/// chosen by.
+pub fn luminance(rgb: Vec3) -> f32 {
+    rgb.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
 /// Surface area of light-table entry `(object, primitive)`: the whole shape, or triangle
 /// `primitive` (in `vertices`) of a mesh. The CPU backend's twin of WGSL `emitter_area`
 /// calls it, inlined into its row renderer (a call would make it save its vector registers).
@@ -51,9 +57,7 @@ pub fn build(
     for (i, object) in objects.iter_mut().enumerate() {
         object.light = NO_LIGHT;
         let e = Vec3::from(materials[object.material as usize].emission);
-        let luminance = e
-            .dot(Vec3::new(0.2126, 0.7152, 0.0722))
-            .max(e.max_element() * 1e-3);
+        let luminance = luminance(e).max(e.max_element() * 1e-3);
         if luminance <= 0.0 {
             continue;
         }

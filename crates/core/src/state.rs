@@ -65,6 +65,9 @@ impl Fingerprint {
     pub fn new(scene: &PreparedScene, camera: &Camera, settings: &RenderSettings) -> Self {
         let (geometry, textures, shading) = (&scene.geometry, &scene.textures, &scene.shading);
         let counts = [shading.object_count, shading.light_count];
+        let map_placement = shading.environment_map.map_or([0; 4], |m| {
+            [m.width, m.height, m.scale.to_bits(), m.rotation.to_bits()]
+        });
         let scene_hash = sha256_hex(&[
             bytemuck::cast_slice(&geometry.nodes),
             bytemuck::cast_slice(&geometry.primitives),
@@ -79,7 +82,7 @@ impl Fingerprint {
             bytemuck::cast_slice(&shading.environment.to_array()),
             bytemuck::cast_slice(&scene.environment.texels),
             bytemuck::cast_slice(&scene.environment.distribution),
-            format!("{:?}", shading.environment_map).as_bytes(),
+            bytemuck::cast_slice(&map_placement),
         ]);
         let gpu_camera = GpuCamera::new(camera);
         Self {

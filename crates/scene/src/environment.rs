@@ -219,6 +219,22 @@ mod tests {
     }
 
     #[test]
+    fn chromaticities_convert_through_xyz_without_white_adaptation() {
+        // Rec. 709 primaries with D65 white: the published sRGB to XYZ matrix.
+        let m = rgb_to_xyz(&REC709);
+        let published = DMat3::from_cols_array(&[
+            0.4124, 0.2126, 0.0193, 0.3576, 0.7152, 0.1192, 0.1805, 0.0722, 0.9505,
+        ]);
+        assert!(m.abs_diff_eq(published, 2e-4), "{m}");
+        // A file's white maps to its white's chromaticity expressed in Rec. 709: for a D50
+        // white, warmer than (1, 1, 1) (no adaptation, as OpenEXR's RGBtoXYZ/XYZtoRGB).
+        let mut d50 = REC709;
+        d50[3] = [0.3457, 0.3585];
+        let white = rgb_to_xyz(&REC709).inverse() * rgb_to_xyz(&d50) * DVec3::ONE;
+        assert!(white.x > 1.05 && white.z < 0.8, "{white}");
+    }
+
+    #[test]
     fn a_map_of_equal_texels_is_a_constant_environment() {
         let image = |texels: Vec<[f32; 3]>| {
             Arc::new(HdrImage {

@@ -289,7 +289,8 @@ impl Viewer {
         Ok(())
     }
 
-    /// The surface under window point `at` (the window's pixels scaled to the image's).
+    /// The surface under window point `at` (the window's pixels scaled to the image's);
+    /// nothing before the window opens.
     fn pick_at(&self, at: PhysicalPosition<f64>) -> Option<Picked> {
         let size = self.window.as_ref()?.window.inner_size();
         let (width, height) = (self.scene.camera.width, self.scene.camera.height);
@@ -301,9 +302,6 @@ impl Viewer {
     /// A left click at window point `at`: toggles the object there between a light and
     /// its material, and gives the renderer the new materials.
     fn click(&mut self, at: PhysicalPosition<f64>) -> anyhow::Result<()> {
-        if self.window.is_none() {
-            return Ok(());
-        }
         let Some(picked) = self.pick_at(at) else {
             say!("picked nothing");
             return Ok(());
@@ -325,9 +323,6 @@ impl Viewer {
 
     /// Focuses the lens on the surface under window point `at`.
     fn focus(&mut self, at: PhysicalPosition<f64>) -> anyhow::Result<()> {
-        if self.window.is_none() {
-            return Ok(());
-        }
         let Some(picked) = self.pick_at(at) else {
             say!("nothing to focus on");
             return Ok(());
