@@ -9,14 +9,21 @@ use pathlight_cpu::{CpuRenderer, InstructionSet};
 use pathlight_render::context::{AutoChoice, auto_choice, available_adapters, describe};
 use pathlight_render::{Accel, GpuContext, GpuRenderer};
 use pathlight_scene::settings::{check_max_depth, check_resolution};
-use pathlight_scene::{Environment, HdrImage, Sampler, Scene, default_scene, load_scene_file};
+use pathlight_scene::{
+    Environment, HdrImage, Sampler, Scene, default_scene, gltf_scene, load_scene_file,
+};
 
 use crate::cli::{Backend, DeviceArgs, SamplerChoice, SceneArgs};
 
 /// Loads the scene named on the command line (or the default scene) with its overrides
 /// applied, refusing bad values.
 pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Scene> {
+    let gltf = args.scene.as_deref().is_some_and(is_gltf);
+    if args.camera.is_some() && !gltf {
+        anyhow::bail!("--camera chooses a camera of a glTF file (.gltf, .glb)");
+    }
     let mut scene = match &args.scene {
+        Some(path) if gltf => gltf_scene(path, args.camera)?,
         Some(path) => load_scene_file(path)?,
         None => default_scene::load().context("the built-in default scene")?,
     };
@@ -43,6 +50,13 @@ pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Scene> {
     apply_environment(&mut scene, args)?;
     apply_lens(&mut scene, args)?;
     Ok(scene)
+}
+
+/// Whether `path` names a glTF file (by its extension, `.gltf` or `.glb`, any case).
+fn is_gltf(path: &std::path::Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("gltf") || e.eq_ignore_ascii_case("glb"))
 }
 
 /// `--env`, `--env-strength` and `--env-rotation`.

@@ -46,8 +46,13 @@ pub enum Backend {
 /// The scene and the settings every command may override.
 #[derive(Debug, clap::Args)]
 pub struct SceneArgs {
-    /// Scene file (TOML, see docs/scene-format.md); the built-in default scene when absent.
+    /// Scene file: TOML (see docs/scene-format.md) or glTF 2.0 (`.gltf`, `.glb`); the
+    /// built-in default scene when absent.
     pub scene: Option<PathBuf>,
+    /// Use the glTF file's perspective camera N (counted from 0 in node order) instead of
+    /// its first (or, with none, one framing the model).
+    #[arg(long, value_name = "N")]
+    pub camera: Option<usize>,
     /// Image width in pixels (overrides the scene's camera resolution).
     #[arg(long)]
     pub width: Option<u32>,
@@ -251,6 +256,7 @@ impl ViewArgs {
         Self {
             scene: SceneArgs {
                 scene: None,
+                camera: None,
                 width: None,
                 height: None,
                 seed: None,

@@ -16,6 +16,7 @@ use pathlight_scene::{Object, Shape, TriangleMesh};
 use rayon::prelude::*;
 
 use crate::bvh;
+use crate::octahedral;
 use crate::error::GeometryError;
 use crate::gpu_types::{
     FLAG_CAPS, FLAG_FLAT, GpuObject, GpuPrimitive, GpuVertex, GpuWideNode, KIND_CYLINDER,
@@ -182,14 +183,20 @@ impl Geometry {
                 let Some(mesh) = mesh_of(p) else {
                     return [GpuVertex::zeroed(); 3]; // Not reached: every slot is a mesh's.
                 };
-                mesh.indices[p.triangle as usize].map(|v| {
-                    let v = v as usize;
-                    let uv = mesh.uvs.get(v).copied().unwrap_or_default();
+                let corners = mesh.indices[p.triangle as usize];
+                std::array::from_fn(|k| {
+                    let v = corners[k] as usize;
+                    let tangent = mesh.tangents.get(3 * p.triangle as usize + k);
                     GpuVertex {
                         position: mesh.positions[v].to_array(),
-                        u: uv.x,
-                        normal: mesh.normals.get(v).copied().unwrap_or_default().to_array(),
-                        v: uv.y,
+                        normal: octahedral::encode(
+                            mesh.normals.get(v).copied().unwrap_or_default(),
+                        ),
+                        uv: mesh.uvs.get(v).copied().unwrap_or_default().to_array(),
+                        tangent: tangent.map_or(octahedral::ZERO, |t| {
+                            octahedral::encode(t.truncate())
+                        }),
+                        tangent_sign: tangent.map_or(1.0, |t| if t.w < 0.0 { -1.0 } else { 1.0 }),
                     }
                 })
             })
@@ -271,6 +278,13 @@ fn check_shape(shape: &Shape) -> Result<(), String> {
         Shape::Mesh(mesh) => {
             for (i, p) in mesh.positions.iter().enumerate() {
                 point(&format!("vertex {i}"), *p)?;
+            }
+            if !mesh.tangents.is_empty() && mesh.tangents.len() != 3 * mesh.indices.len() {
+                return Err(format!(
+                    "it has {} tangents for {} triangle corners",
+                    mesh.tangents.len(),
+                    3 * mesh.indices.len()
+                ));
             }
             let count = mesh.positions.len() as u32;
             match mesh

@@ -28,6 +28,9 @@ pub const SAMPLER_INDEPENDENT: u32 = 1;
 pub const FLAG_FLAT: u32 = 1;
 /// [`GpuObject::flags`] bit: a cylinder closed by two disks.
 pub const FLAG_CAPS: u32 = 2;
+/// [`GpuObject::flags`] bit: a mesh whose material has alpha holes (masked or blended), so
+/// that a ray tests the texel where it hits before it stops.
+pub const FLAG_ALPHA: u32 = 4;
 
 /// One object of the scene, in the scene's order. WGSL: `Object`.
 ///
@@ -111,17 +114,20 @@ const _: () = assert!(size_of::<GpuWideNode>() == 128);
 pub const SHAPE_LEAF: u32 = 1 << 31;
 
 /// One triangle corner. WGSL: `Vertex`; a triangle is three consecutive vertices.
+/// Unit vectors are octahedral-encoded ([`crate::octahedral`]) to keep a corner in 32 bytes.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuVertex {
     /// World position.
     pub position: [f32; 3],
-    /// Texture coordinate u.
-    pub u: f32,
-    /// Shading normal (unit).
-    pub normal: [f32; 3],
-    /// Texture coordinate v.
-    pub v: f32,
+    /// Shading normal (unit, or [`crate::octahedral::ZERO`] for none).
+    pub normal: u32,
+    /// Texture coordinates.
+    pub uv: [f32; 2],
+    /// Tangent along +u (unit; [`crate::octahedral::ZERO`] when the mesh has none).
+    pub tangent: u32,
+    /// Sign of the bitangent: `cross(normal, tangent) * tangent_sign` points along +v.
+    pub tangent_sign: f32,
 }
 const _: () = assert!(size_of::<GpuVertex>() == 32);
 
@@ -150,15 +156,60 @@ pub struct GpuPrimitive {
 }
 const _: () = assert!(size_of::<GpuPrimitive>() == 48);
 
+/// [`GpuMaterial::model`]: the seed's lobe mixture.
+pub const MODEL_LOBES: u32 = 0;
+/// [`GpuMaterial::model`]: glTF's metal-rough model.
+pub const MODEL_METAL_ROUGH: u32 = 1;
+
+/// [`GpuMaterial::flags`] bit: transmission through a thin wall.
+pub const MATERIAL_THIN: u32 = 1;
+/// [`GpuMaterial::flags`] bit: texels with alpha below `alpha_cutoff` are holes.
+pub const MATERIAL_MASK: u32 = 2;
+/// [`GpuMaterial::flags`] bit: alpha is the probability that a ray stops.
+pub const MATERIAL_BLEND: u32 = 4;
+
+/// [`GpuMaterial::slots`]: the base colour (sRGB; alpha in its fourth channel).
+pub const SLOT_BASE: usize = 0;
+/// [`GpuMaterial::slots`]: metallic (blue) and roughness (green), linear.
+pub const SLOT_METAL_ROUGH: usize = 1;
+/// [`GpuMaterial::slots`]: the tangent-space normal map, linear.
+pub const SLOT_NORMAL: usize = 2;
+/// [`GpuMaterial::slots`]: the emission, sRGB.
+pub const SLOT_EMISSION: usize = 3;
+
+/// [`GpuTextureSlot::wrap`] mode (2 bits per axis, u in the low bits): tile.
+pub const WRAP_REPEAT: u32 = 0;
+/// [`GpuTextureSlot::wrap`] mode: hold the edge texel.
+pub const WRAP_CLAMP: u32 = 1;
+/// [`GpuTextureSlot::wrap`] mode: tile, every other copy mirrored.
+pub const WRAP_MIRROR: u32 = 2;
+
+/// One use of a texture by a material: which texture, the affine map from surface to
+/// texture coordinates and the wrapping. WGSL: `TextureSlot`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuTextureSlot {
+    /// Texture u = dot(u.xy, uv) + u.z.
+    pub u: [f32; 3],
+    /// Index into the texture table, or -1 for none.
+    pub texture: i32,
+    /// Texture v = dot(v.xy, uv) + v.z.
+    pub v: [f32; 3],
+    /// `WRAP_*` of u, then of v shifted left by 2.
+    pub wrap: u32,
+}
+const _: () = assert!(size_of::<GpuTextureSlot>() == 32);
+
 /// A material in linear RGB. WGSL: `Material`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuMaterial {
-    /// Base colour.
+    /// Base colour (multiplied by the base texture under the metal-rough model, replaced
+    /// by it under the lobes).
     pub base_color: [f32; 3],
-    /// Index into the texture table, or -1.
-    pub texture: i32,
-    /// Emitted radiance (front side).
+    /// `MODEL_*`.
+    pub model: u32,
+    /// Emitted radiance (front side), multiplied by the emission texture.
     pub emission: [f32; 3],
     /// Weight of the specular lobe.
     pub specular_rate: f32,
@@ -174,16 +225,30 @@ pub struct GpuMaterial {
     pub refract_rate: f32,
     /// Transmitted colour between white and base colour.
     pub refract_tint: f32,
-    /// Index of refraction of the inside.
+    /// Index of refraction of the inside (both models).
     pub ior: f32,
     /// Roughness of transmission.
     pub refract_roughness: f32,
     /// 1: the specular lobe uses the complex-IOR conductor Fresnel; 0: Schlick.
     pub conductor: u32,
-    /// Padding to 16 bytes.
-    pub pad: [u32; 3],
+    /// Metal-rough: 0 dielectric, 1 metal.
+    pub metallic: f32,
+    /// Metal-rough: perceptual roughness.
+    pub roughness: f32,
+    /// Metal-rough: fraction of the dielectric base that transmits.
+    pub transmission: f32,
+    /// Metal-rough: scale of the normal map's x and y.
+    pub normal_scale: f32,
+    /// Metal-rough: alpha below which a masked texel is a hole.
+    pub alpha_cutoff: f32,
+    /// Metal-rough: base colour alpha factor.
+    pub alpha_factor: f32,
+    /// `MATERIAL_*` bits.
+    pub flags: u32,
+    /// The textures, by `SLOT_*`.
+    pub slots: [GpuTextureSlot; 4],
 }
-const _: () = assert!(size_of::<GpuMaterial>() == 96);
+const _: () = assert!(size_of::<GpuMaterial>() == 240);
 
 /// Where a texture's texels lie in the texel buffer. WGSL: `TextureInfo`.
 #[repr(C)]

@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use crate::geometry::Geometry;
 use crate::gpu_types::{
-    FLAG_CAPS, GpuLight, GpuMaterial, GpuObject, GpuVertex, KIND_CYLINDER, KIND_MESH, KIND_QUAD,
+    FLAG_CAPS, GpuLight, GpuObject, GpuVertex, KIND_CYLINDER, KIND_MESH, KIND_QUAD,
     KIND_SPHERE, NO_LIGHT,
 };
 
@@ -45,18 +45,19 @@ pub fn emitter_area(object: &GpuObject, vertices: &[GpuVertex], primitive: u32) 
 }
 
 /// The light table of `objects` (with their materials set) in `geometry`, never empty (a
-/// placeholder when nothing emits), and the number of real entries. Sets each object's
-/// `light` to its first entry, or [`NO_LIGHT`].
+/// placeholder when nothing emits), and the number of real entries; `emission` is each
+/// material's mean emitted radiance. Sets each object's `light` to its first entry, or
+/// [`NO_LIGHT`].
 pub fn build(
     objects: &mut [GpuObject],
-    materials: &[GpuMaterial],
+    emission: &[Vec3],
     geometry: &Geometry,
 ) -> (Vec<GpuLight>, u32) {
     let mut lights = Vec::new();
     let mut powers = Vec::new();
     for (i, object) in objects.iter_mut().enumerate() {
         object.light = NO_LIGHT;
-        let e = Vec3::from(materials[object.material as usize].emission);
+        let e = emission[object.material as usize];
         let luminance = luminance(e).max(e.max_element() * 1e-3);
         if luminance <= 0.0 {
             continue;

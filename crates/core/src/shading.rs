@@ -4,11 +4,15 @@
 
 use bytemuck::Zeroable;
 use glam::Vec3;
-use pathlight_scene::{Conductor, Environment, Material, Scene};
+use pathlight_scene::{AlphaMode, Conductor, Environment, Material, Scene, Texture, TextureRef, Wrap};
 
 use crate::environment::texel_scale;
 use crate::geometry::Geometry;
-use crate::gpu_types::{GpuLight, GpuMaterial, GpuObject};
+use crate::gpu_types::{
+    FLAG_ALPHA, GpuLight, GpuMaterial, GpuObject, GpuTextureSlot, KIND_MESH, MATERIAL_BLEND,
+    MATERIAL_MASK, MATERIAL_THIN, MODEL_LOBES, MODEL_METAL_ROUGH, SLOT_BASE, SLOT_EMISSION,
+    SLOT_METAL_ROUGH, SLOT_NORMAL, WRAP_CLAMP, WRAP_MIRROR, WRAP_REPEAT,
+};
 use crate::light_table;
 
 /// The materials and lights of a scene, in the form both backends read.
@@ -60,7 +64,18 @@ impl Shading {
                 ..*shape
             })
             .collect();
-        let (lights, light_count) = light_table::build(&mut objects, &materials, geometry);
+        for object in &mut objects {
+            let flags = materials[object.material as usize].flags;
+            if object.kind == KIND_MESH && flags & (MATERIAL_MASK | MATERIAL_BLEND) != 0 {
+                object.flags |= FLAG_ALPHA;
+            }
+        }
+        let emission: Vec<Vec3> = scene
+            .materials
+            .iter()
+            .map(|m| mean_emission(m, &scene.textures))
+            .collect();
+        let (lights, light_count) = light_table::build(&mut objects, &emission, geometry);
         let object_count = objects.len() as u32;
         if objects.is_empty() {
             objects.push(GpuObject::zeroed());
@@ -94,9 +109,11 @@ fn gpu_material(m: &Material) -> GpuMaterial {
         eta: Vec3::ONE,
         k: Vec3::ZERO,
     });
-    GpuMaterial {
+    let mut slots = [texture_slot(None); 4];
+    slots[SLOT_BASE] = texture_slot(m.texture.as_ref());
+    let mut out = GpuMaterial {
         base_color: m.base_color.to_array(),
-        texture: m.texture.map_or(-1, |t| t as i32),
+        model: MODEL_LOBES,
         emission: m.emission.to_array(),
         specular_rate: m.lobes.specular_rate,
         eta: conductor.eta.to_array(),
@@ -108,6 +125,68 @@ fn gpu_material(m: &Material) -> GpuMaterial {
         ior: m.lobes.ior,
         refract_roughness: m.lobes.refract_roughness,
         conductor: u32::from(m.conductor.is_some()),
-        pad: [0; 3],
+        metallic: 0.0,
+        roughness: 0.0,
+        transmission: 0.0,
+        normal_scale: 1.0,
+        alpha_cutoff: 0.0,
+        alpha_factor: 1.0,
+        flags: 0,
+        slots,
+    };
+    if let Some(pbr) = &m.metal_rough {
+        out.model = MODEL_METAL_ROUGH;
+        out.metallic = pbr.metallic;
+        out.roughness = pbr.roughness;
+        out.ior = pbr.ior;
+        out.transmission = pbr.transmission;
+        out.normal_scale = pbr.normal_scale;
+        out.alpha_factor = pbr.alpha_factor;
+        out.flags = if pbr.thin { MATERIAL_THIN } else { 0 };
+        match pbr.alpha {
+            AlphaMode::Opaque => {}
+            AlphaMode::Mask(cutoff) => {
+                out.flags |= MATERIAL_MASK;
+                out.alpha_cutoff = cutoff;
+            }
+            AlphaMode::Blend => out.flags |= MATERIAL_BLEND,
+        }
+        out.slots[SLOT_METAL_ROUGH] = texture_slot(pbr.metal_rough_texture.as_ref());
+        out.slots[SLOT_NORMAL] = texture_slot(pbr.normal_texture.as_ref());
+        out.slots[SLOT_EMISSION] = texture_slot(pbr.emission_texture.as_ref());
     }
+    out
+}
+
+/// A texture use as the shaders read it; texture -1 for none.
+fn texture_slot(r: Option<&TextureRef>) -> GpuTextureSlot {
+    let Some(r) = r else {
+        return GpuTextureSlot {
+            u: [1.0, 0.0, 0.0],
+            texture: -1,
+            v: [0.0, 1.0, 0.0],
+            wrap: 0,
+        };
+    };
+    let mode = |w: Wrap| match w {
+        Wrap::Repeat => WRAP_REPEAT,
+        Wrap::Clamp => WRAP_CLAMP,
+        Wrap::Mirror => WRAP_MIRROR,
+    };
+    GpuTextureSlot {
+        u: r.transform[0],
+        texture: r.texture as i32,
+        v: r.transform[1],
+        wrap: mode(r.wrap[0]) | (mode(r.wrap[1]) << 2),
+    }
+}
+
+/// A material's mean emitted radiance: its emission times its emission texture's mean (what
+/// its emitters are chosen by).
+fn mean_emission(m: &Material, textures: &[Texture]) -> Vec3 {
+    let texture = m
+        .metal_rough
+        .and_then(|pbr| pbr.emission_texture)
+        .and_then(|r| textures.get(r.texture as usize));
+    m.emission * texture.map_or(Vec3::ONE, Texture::mean_linear)
 }

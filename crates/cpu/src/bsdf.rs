@@ -16,7 +16,9 @@
 use std::f32::consts::{FRAC_1_PI, PI};
 
 use glam::{Vec2, Vec3A};
-use pathlight_core::gpu_types::GpuMaterial;
+use pathlight_core::gpu_types::{GpuMaterial, MODEL_METAL_ROUGH};
+
+use crate::metal_rough;
 
 use crate::sampling::{Frame, sample_cosine_hemisphere, sin_cos_turns};
 use crate::surface::Surface;
@@ -51,7 +53,7 @@ pub struct BsdfSample {
     pub valid: bool,
 }
 
-const INVALID: BsdfSample = BsdfSample {
+pub(crate) const INVALID: BsdfSample = BsdfSample {
     wi: Vec3A::ZERO,
     weight: Vec3A::ZERO,
     pdf: 0.0,
@@ -147,7 +149,7 @@ pub fn ggx_sample_visible(wo: Vec3A, alpha: f32, u: Vec2) -> Vec3A {
 
 /// Density of `ggx_sample_visible` producing `m`. Twin of WGSL `ggx_pdf_visible`.
 #[inline(always)]
-fn ggx_pdf_visible(wo: Vec3A, m: Vec3A, alpha: f32) -> f32 {
+pub(crate) fn ggx_pdf_visible(wo: Vec3A, m: Vec3A, alpha: f32) -> f32 {
     ggx_g1(wo, alpha) * wo.dot(m).abs() * ggx_d(m, alpha) / wo.z.abs()
 }
 
@@ -175,6 +177,9 @@ fn fresnel_dielectric_local(cos_om: f32, ior: f32) -> f32 {
 /// The continuous part of the BSDF. Twin of WGSL `eval_bsdf`.
 #[inline(always)]
 pub fn eval_bsdf(m: &GpuMaterial, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfEval {
+    if m.model == MODEL_METAL_ROUGH {
+        return metal_rough::eval(m, s, wo, wi);
+    }
     let weights = lobe_weights(m);
     let front = wo.dot(s.ng) >= 0.0;
     let sign = if front { 1.0 } else { -1.0 };
@@ -216,7 +221,7 @@ pub fn eval_bsdf(m: &GpuMaterial, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3
 /// Rough dielectric (pbrt-v4 `DielectricBxDF::f` and `PDF`, separable Smith) in the frame
 /// of the outward shading normal. Twin of WGSL `eval_rough_dielectric`.
 #[inline(always)]
-fn eval_rough_dielectric(
+pub(crate) fn eval_rough_dielectric(
     m: &GpuMaterial,
     color: Vec3A,
     s: &Surface,
@@ -313,6 +318,9 @@ pub fn sample_bsdf(
     u_fresnel: f32,
     u: Vec2,
 ) -> BsdfSample {
+    if m.model == MODEL_METAL_ROUGH {
+        return metal_rough::sample(m, s, wo, u_lobe, u_fresnel, u);
+    }
     let weights = lobe_weights(m);
     let front = wo.dot(s.ng) >= 0.0;
     let sign = if front { 1.0 } else { -1.0 };
@@ -353,37 +361,10 @@ pub fn sample_bsdf(
         if alpha < ALPHA_MIN {
             return sample_smooth_dielectric(m, color, s, wo, u_fresnel);
         }
-        let frame = Frame::around(s.ns);
-        let wo_l = frame.to_local(wo);
-        if wo_l.z == 0.0 {
-            return INVALID;
-        }
-        let h = ggx_sample_visible(wo_l, alpha, u);
-        let cos_oh = wo_l.dot(h);
-        let fr = fresnel_dielectric_local(cos_oh, m.ior);
-        let reflect = u_fresnel < fr;
-        let wi_l = if reflect {
-            2.0 * cos_oh * h - wo_l
-        } else {
-            // Refract wo through h: relative IOR seen from wo's side.
-            let (eta, hf, c) = if cos_oh >= 0.0 {
-                (m.ior, h, cos_oh)
-            } else {
-                (1.0 / m.ior, -h, -cos_oh)
-            };
-            let sin2_t = (1.0 - c * c) / (eta * eta);
-            if sin2_t >= 1.0 {
-                return INVALID;
-            }
-            -wo_l / eta + (c / eta - (1.0 - sin2_t).sqrt()) * hf
+        return match rough_dielectric_direction(m.ior, s, wo, alpha, u_fresnel, u) {
+            Some(wi) => mixture_sample(m, color, s, wo, wi),
+            None => INVALID,
         };
-        // Through a microfacet, a reflection can point below the surface and a refraction
-        // above it: such a direction belongs to the other lobe, whose density does not
-        // count this way of reaching it, so it is discarded (as pbrt-v4 and Mitsuba do).
-        if (wi_l.z * wo_l.z > 0.0) != reflect {
-            return INVALID;
-        }
-        return mixture_sample(m, color, s, wo, frame.to_world(wi_l));
     }
     if cos_o <= 0.0 {
         return INVALID;
@@ -395,10 +376,55 @@ pub fn sample_bsdf(
     mixture_sample(m, color, s, wo, wi)
 }
 
+/// A direction sampled from a rough dielectric interface of relative index `ior` about
+/// `s.ns`: reflection or refraction of a visible GGX normal, chosen by its Fresnel
+/// reflectance. Twin of WGSL `rough_dielectric_direction`.
+#[inline(always)]
+pub(crate) fn rough_dielectric_direction(
+    ior: f32,
+    s: &Surface,
+    wo: Vec3A,
+    alpha: f32,
+    u_fresnel: f32,
+    u: Vec2,
+) -> Option<Vec3A> {
+    let frame = Frame::around(s.ns);
+    let wo_l = frame.to_local(wo);
+    if wo_l.z == 0.0 {
+        return None;
+    }
+    let h = ggx_sample_visible(wo_l, alpha, u);
+    let cos_oh = wo_l.dot(h);
+    let fr = fresnel_dielectric_local(cos_oh, ior);
+    let reflect = u_fresnel < fr;
+    let wi_l = if reflect {
+        2.0 * cos_oh * h - wo_l
+    } else {
+        // Refract wo through h: relative IOR seen from wo's side.
+        let (eta, hf, c) = if cos_oh >= 0.0 {
+            (ior, h, cos_oh)
+        } else {
+            (1.0 / ior, -h, -cos_oh)
+        };
+        let sin2_t = (1.0 - c * c) / (eta * eta);
+        if sin2_t >= 1.0 {
+            return None;
+        }
+        -wo_l / eta + (c / eta - (1.0 - sin2_t).sqrt()) * hf
+    };
+    // Through a microfacet, a reflection can point below the surface and a refraction
+    // above it: such a direction belongs to the other lobe, whose density does not
+    // count this way of reaching it, so it is discarded (as pbrt-v4 and Mitsuba do).
+    if (wi_l.z * wo_l.z > 0.0) != reflect {
+        return None;
+    }
+    Some(frame.to_world(wi_l))
+}
+
 /// Smooth dielectric: reflect with probability F, else refract; radiance scaled by
 /// 1/eta^2 on refraction (as Mitsuba and pbrt do). Twin of WGSL `sample_smooth_dielectric`.
 #[inline(always)]
-fn sample_smooth_dielectric(
+pub(crate) fn sample_smooth_dielectric(
     m: &GpuMaterial,
     color: Vec3A,
     s: &Surface,
@@ -445,6 +471,9 @@ fn sample_smooth_dielectric(
 /// Twin of WGSL `has_continuous_lobe`.
 #[inline(always)]
 pub fn has_continuous_lobe(m: &GpuMaterial) -> bool {
+    if m.model == MODEL_METAL_ROUGH {
+        return metal_rough::has_continuous_lobe(m);
+    }
     let w = lobe_weights(m);
     w.x > 0.0
         || (w.y > 0.0 && m.specular_roughness * m.specular_roughness >= ALPHA_MIN)

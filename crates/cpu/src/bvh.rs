@@ -6,10 +6,11 @@
 
 use glam::{Vec3, Vec4};
 use pathlight_core::gpu_types::{
-    FLAG_CAPS, GpuWideNode, KIND_QUAD, KIND_SPHERE, NO_TRIANGLE, SHAPE_LEAF,
+    FLAG_ALPHA, FLAG_CAPS, GpuWideNode, KIND_QUAD, KIND_SPHERE, NO_TRIANGLE, SHAPE_LEAF,
 };
 
 use crate::cpu_scene::CpuScene;
+use crate::textures::alpha_stops;
 use crate::intersect::{
     ROBUST_FAR, Ray, ShearedRay, intersect_cylinder, intersect_quad, intersect_sphere,
     intersect_triangle, safe_inverse,
@@ -142,7 +143,10 @@ impl CpuScene<'_> {
         }
         let [v0, v1, v2] = [p.v0, p.v1, p.v2].map(Vec3::from);
         let (t, b1, b2) = intersect_triangle(v0, v1, v2, sheared, hit.t);
-        if t < hit.t {
+        if t < hit.t
+            && (self.objects[p.object as usize].flags & FLAG_ALPHA == 0
+                || alpha_stops(self, p.object, p.triangle, b1, b2, t))
+        {
             *hit = Hit {
                 t,
                 object: p.object,

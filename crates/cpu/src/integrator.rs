@@ -13,7 +13,7 @@ use crate::intersect::Ray;
 use crate::lights::{LightSample, env_pdf, light_pdf, sample_light};
 use crate::sampler::{Draw, Sampler};
 use crate::sampling::power_heuristic;
-use crate::surface::{base_color, surface_at};
+use crate::surface::{material_at, surface_at};
 
 /// Largest radiance one sample may add per channel (WGSL `SAMPLE_MAX`).
 pub const SAMPLE_MAX: f32 = 16_777_216.0;
@@ -143,7 +143,7 @@ impl Path {
             return None;
         };
         let s = surface_at(scene, &hit, &ray);
-        let material = &scene.materials[s.material as usize];
+        let material = &material_at(scene, &scene.materials[s.material as usize], s.uv);
         let wo = -Vec3A::from(ray.dir);
         let emission = Vec3A::from(material.emission);
         if wo.dot(s.ng) > 0.0 && emission.max_element() > 0.0 {
@@ -179,7 +179,7 @@ impl Path {
         ]);
         let (u_light_select, u_lobe, u_fresnel, u_rr) =
             (u_light_select.x, u_lobe.x, u_fresnel.x, u_rr.x);
-        let color = base_color(scene, material, s.uv);
+        let color = Vec3A::from(material.base_color);
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
         let mut shadow = None;
         if has_continuous_lobe(material) {

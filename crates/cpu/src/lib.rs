@@ -14,11 +14,13 @@ pub mod environment;
 pub mod integrator;
 pub mod intersect;
 pub mod lights;
+pub mod metal_rough;
 pub mod packet;
 mod row;
 pub mod sampler;
 pub mod sampling;
 pub mod surface;
+pub mod textures;
 
 use std::ops::Range;
 use std::time::{Duration, Instant};

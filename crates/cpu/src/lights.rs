@@ -16,6 +16,8 @@ use pathlight_core::gpu_types::{
 use pathlight_core::light_table;
 
 use crate::cpu_scene::CpuScene;
+use crate::surface::material_at;
+use crate::textures::triangle_uv;
 use crate::environment::{env_map_pdf, env_radiance, has_env_map, sample_env_map};
 use crate::intersect::{MISS, Ray, intersect_sphere};
 use crate::sampling::{
@@ -274,7 +276,15 @@ pub fn sample_light(
     } else {
         pmf * density * distance * distance / cos_l
     };
-    let radiance = Vec3A::from(scene.materials[o.material as usize].emission);
+    let material = &scene.materials[o.material as usize];
+    let radiance = if o.kind == KIND_MESH {
+        // The barycentrics `sample_shape` drew the point at.
+        let su = u.x.sqrt();
+        let uv = triangle_uv(scene, light.primitive, 1.0 - su, u.y * su);
+        Vec3A::from(material_at(scene, material, uv).emission)
+    } else {
+        Vec3A::from(material.emission)
+    };
     LightSample {
         wi,
         point: q,

@@ -15,13 +15,14 @@ use std::ops::Range;
 use glam::Vec3;
 
 use pathlight_core::gpu_types::{
-    FLAG_CAPS, GpuWideNode, KIND_QUAD, KIND_SPHERE, NO_TRIANGLE, SHAPE_LEAF,
+    FLAG_ALPHA, FLAG_CAPS, GpuWideNode, KIND_QUAD, KIND_SPHERE, NO_TRIANGLE, SHAPE_LEAF,
 };
 
 use crate::bvh::{Entry, Hit, RayLanes, Tracer, Walk};
 use crate::cpu_scene::CpuScene;
+use crate::textures::alpha_stops;
 use crate::intersect::{
-    ROBUST_FAR, Ray, ShearedRay, intersect_cylinder, intersect_quad, intersect_sphere,
+    MISS, ROBUST_FAR, Ray, ShearedRay, intersect_cylinder, intersect_quad, intersect_sphere,
     intersect_triangle, safe_inverse,
 };
 
@@ -257,6 +258,26 @@ impl ShapeTest for Triangle {
     }
 }
 
+/// A triangle of a mesh with alpha holes: a hit counts only where its texel stops the ray.
+struct CutOutTriangle<'a> {
+    corners: [Vec3; 3],
+    scene: &'a CpuScene<'a>,
+    object: u32,
+    triangle: u32,
+}
+
+impl ShapeTest for CutOutTriangle<'_> {
+    #[inline(always)]
+    fn intersect(&self, rays: &PacketRays, l: usize, t_max: f32) -> (f32, f32, f32) {
+        let [v0, v1, v2] = self.corners;
+        let (t, b1, b2) = intersect_triangle(v0, v1, v2, &rays.sheared(l), t_max);
+        if t < t_max && !alpha_stops(self.scene, self.object, self.triangle, b1, b2, t) {
+            return (MISS, 0.0, 0.0);
+        }
+        (t, b1, b2)
+    }
+}
+
 /// Smaller of two numbers that are not NaN (one instruction, unlike `f32::min`).
 #[inline(always)]
 fn min(a: f32, b: f32) -> f32 {
@@ -434,8 +455,18 @@ impl PacketWalk<'_> {
             let lanes = lanes & hits.searching;
             let p = &self.scene.primitives[i as usize];
             if p.triangle != NO_TRIANGLE {
-                let triangle = Triangle([p.v0, p.v1, p.v2].map(Vec3::from));
-                hits.test(rays, lanes, p.object, p.triangle, &triangle);
+                let corners = [p.v0, p.v1, p.v2].map(Vec3::from);
+                if self.scene.objects[p.object as usize].flags & FLAG_ALPHA != 0 {
+                    let triangle = CutOutTriangle {
+                        corners,
+                        scene: self.scene,
+                        object: p.object,
+                        triangle: p.triangle,
+                    };
+                    hits.test(rays, lanes, p.object, p.triangle, &triangle);
+                } else {
+                    hits.test(rays, lanes, p.object, p.triangle, &Triangle(corners));
+                }
                 continue;
             }
             let o = &self.scene.objects[p.object as usize];

@@ -4,13 +4,16 @@ use std::f32::consts::{PI, TAU};
 
 use glam::{Vec2, Vec3A};
 use pathlight_core::gpu_types::{
-    FLAG_CAPS, FLAG_FLAT, GpuMaterial, GpuTextureInfo, KIND_CYLINDER, KIND_QUAD, KIND_SPHERE,
+    FLAG_CAPS, FLAG_FLAT, GpuMaterial, KIND_CYLINDER, KIND_QUAD, KIND_SPHERE, MODEL_METAL_ROUGH,
+    SLOT_BASE, SLOT_EMISSION, SLOT_METAL_ROUGH, SLOT_NORMAL,
 };
+use pathlight_core::octahedral;
 
 use crate::bvh::Hit;
 use crate::cpu_scene::CpuScene;
 use crate::intersect::Ray;
 use crate::sampling::Frame;
+use crate::textures::{sample_slot, srgb_to_linear};
 
 /// The surface at a hit. Twin of WGSL `Surface`.
 #[derive(Debug, Clone, Copy)]
@@ -27,46 +30,54 @@ pub struct Surface {
     pub material: u32,
 }
 
-/// sRGB decoding. Twin of WGSL `srgb_to_linear`.
-fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// Twin of WGSL `texel`.
-fn texel(scene: &CpuScene, info: &GpuTextureInfo, x: u32, y: u32) -> Vec3A {
-    let packed = scene.texels[(info.offset + y * info.width + x) as usize];
-    let [r, g, b, _] = packed.to_le_bytes();
-    Vec3A::new(r as f32, g as f32, b as f32).map(|c| srgb_to_linear(c / 255.0))
-}
-
-/// Bilinear lookup, u wraps, v clamps. Twin of WGSL `sample_texture`.
-fn sample_texture(scene: &CpuScene, index: u32, uv: Vec2) -> Vec3A {
-    let info = &scene.textures[index as usize];
-    let size = Vec2::new(info.width as f32, info.height as f32);
-    let p = Vec2::new(uv.x - uv.x.floor(), uv.y.clamp(0.0, 1.0)) * size - 0.5;
-    let f = p - p.floor();
-    let base = p.floor();
-    let x0 = ((base.x + size.x) as i32 % info.width as i32) as u32;
-    let x1 = (x0 + 1) % info.width;
-    let y0 = base.y.clamp(0.0, size.y - 1.0) as u32;
-    let y1 = (base.y + 1.0).clamp(0.0, size.y - 1.0) as u32;
-    let top = texel(scene, info, x0, y0).lerp(texel(scene, info, x1, y0), f.x);
-    let bottom = texel(scene, info, x0, y1).lerp(texel(scene, info, x1, y1), f.x);
-    top.lerp(bottom, f.y)
-}
-
-/// The material's colour at `uv`. Twin of WGSL `base_color`.
+/// The material with its textures applied at `uv`. Twin of WGSL `material_at`.
 #[inline(always)]
-pub fn base_color(scene: &CpuScene, material: &GpuMaterial, uv: Vec2) -> Vec3A {
-    if material.texture >= 0 {
-        sample_texture(scene, material.texture as u32, uv)
-    } else {
-        Vec3A::from(material.base_color)
+pub fn material_at(scene: &CpuScene, material: &GpuMaterial, uv: Vec2) -> GpuMaterial {
+    let mut m = *material;
+    if m.slots[SLOT_BASE].texture >= 0 {
+        let color = srgb_to_linear(sample_slot(scene, &m.slots[SLOT_BASE], uv).truncate().into());
+        m.base_color = if m.model == MODEL_METAL_ROUGH {
+            (Vec3A::from(m.base_color) * color).into()
+        } else {
+            color.into()
+        };
     }
+    if m.model != MODEL_METAL_ROUGH {
+        return m;
+    }
+    if m.slots[SLOT_METAL_ROUGH].texture >= 0 {
+        let t = sample_slot(scene, &m.slots[SLOT_METAL_ROUGH], uv);
+        m.roughness *= t.y;
+        m.metallic *= t.z;
+    }
+    if m.slots[SLOT_EMISSION].texture >= 0 {
+        let t = srgb_to_linear(sample_slot(scene, &m.slots[SLOT_EMISSION], uv).truncate().into());
+        m.emission = (Vec3A::from(m.emission) * t).into();
+    }
+    m
+}
+
+/// The shading normal bent by the material's normal map. Twin of WGSL `normal_mapped`.
+fn normal_mapped(
+    scene: &CpuScene,
+    m: &GpuMaterial,
+    uv: Vec2,
+    ns: Vec3A,
+    tangent: Vec3A,
+    sign: f32,
+) -> Vec3A {
+    let t = tangent - tangent.dot(ns) * ns;
+    if t.dot(t) < 1e-12 {
+        return ns;
+    }
+    let tn = t.normalize();
+    let b = ns.cross(tn) * sign;
+    let c = Vec3A::from(sample_slot(scene, &m.slots[SLOT_NORMAL], uv).truncate()) * 2.0 - 1.0;
+    let n = tn * (c.x * m.normal_scale) + b * (c.y * m.normal_scale) + ns * c.z;
+    if n.dot(n) < 1e-12 {
+        return ns;
+    }
+    n.normalize()
 }
 
 /// Twin of WGSL `surface_at`, except that sphere and cylinder texture coordinates (`atan2`,
@@ -76,7 +87,7 @@ pub fn base_color(scene: &CpuScene, material: &GpuMaterial, uv: Vec2) -> Vec3A {
 pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
     let scene = cpu_scene;
     let o = &scene.objects[hit.object as usize];
-    let textured = scene.materials[o.material as usize].texture >= 0;
+    let textured = scene.materials[o.material as usize].slots[SLOT_BASE].texture >= 0;
     let [a, b] = [o.a, o.b].map(|v| Vec3A::from_slice(&v));
     let p = Vec3A::from(ray.origin) + hit.t * Vec3A::from(ray.dir);
     let mut s = Surface {
@@ -133,20 +144,24 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
             let b0 = 1.0 - hit.b1 - hit.b2;
             let [p0, p1, p2] = [v0, v1, v2].map(|v| Vec3A::from(v.position));
             s.ng = (p1 - p0).cross(p2 - p0).normalize();
-            let n = b0 * Vec3A::from(v0.normal)
-                + hit.b1 * Vec3A::from(v1.normal)
-                + hit.b2 * Vec3A::from(v2.normal);
+            let decode = |code: u32| Vec3A::from(octahedral::decode(code));
+            let n = b0 * decode(v0.normal) + hit.b1 * decode(v1.normal) + hit.b2 * decode(v2.normal);
+            s.uv = b0 * Vec2::from(v0.uv) + hit.b1 * Vec2::from(v1.uv) + hit.b2 * Vec2::from(v2.uv);
             if o.flags & FLAG_FLAT != 0 || n.dot(n) < 1e-12 {
                 s.ns = s.ng;
             } else {
                 s.ns = n.normalize();
-                if s.ns.dot(s.ng) < 0.0 {
-                    s.ns = -s.ns;
-                }
             }
-            s.uv = b0 * Vec2::new(v0.u, v0.v)
-                + hit.b1 * Vec2::new(v1.u, v1.v)
-                + hit.b2 * Vec2::new(v2.u, v2.v);
+            let m = &scene.materials[o.material as usize];
+            if m.model == MODEL_METAL_ROUGH && m.slots[SLOT_NORMAL].texture >= 0 {
+                let tangent = b0 * decode(v0.tangent)
+                    + hit.b1 * decode(v1.tangent)
+                    + hit.b2 * decode(v2.tangent);
+                s.ns = normal_mapped(scene, m, s.uv, s.ns, tangent, v0.tangent_sign);
+            }
+            if s.ns.dot(s.ng) < 0.0 {
+                s.ns = -s.ns;
+            }
         }
     }
     s

@@ -16,6 +16,7 @@
 
 #import scene
 #import intersect
+#import textures
 
 const ACCEL_BVH: u32 = 0u;
 const ACCEL_BOUNDING_VOLUME: u32 = 1u;
@@ -71,9 +72,11 @@ fn intersect_shape(i: u32, o: Object, ray: Ray, hit: ptr<function, Hit>) {
 }
 
 // Hit on triangle `triangle` (its corners) of mesh object `object`, if nearer than `hit`.
+// A triangle of a mesh with alpha holes counts only where its texel stops the ray.
 fn hit_triangle(object: u32, triangle: u32, v0: vec3f, v1: vec3f, v2: vec3f, ray: ShearedRay, hit: ptr<function, Hit>) {
     let r = intersect_triangle(v0, v1, v2, ray, (*hit).t);
-    if r.x < (*hit).t {
+    if r.x < (*hit).t
+        && ((objects[object].flags & FLAG_ALPHA) == 0u || alpha_stops(object, triangle, r.y, r.z, r.x)) {
         *hit = Hit(r.x, object, triangle, r.y, r.z);
     }
 }

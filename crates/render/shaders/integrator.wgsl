@@ -141,7 +141,7 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
             break;
         }
         let s = surface_at(hit, ray);
-        let material = materials[s.material];
+        let material = material_at(materials[s.material], s.uv);
         let wo = -ray.dir;
         if dot(wo, s.ng) > 0.0 && max(max(material.emission.x, material.emission.y), material.emission.z) > 0.0 {
             var w = 1.0;
@@ -160,7 +160,7 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
         let u_fresnel = next_1d(sampler);
         let u_bsdf = next_2d(sampler);
         let u_rr = next_1d(sampler);
-        let color = base_color(material, s.uv);
+        let color = material.base_color;
         let n = select(-s.ns, s.ns, dot(wo, s.ng) >= 0.0);
         if has_continuous_lobe(material) {
             let ls = sample_light(s.position, n, u_light_select, u_light);

@@ -9,6 +9,7 @@
 #import intersect
 #import sampling
 #import environment
+#import surface
 
 // CPU twin: `LightSample`.
 struct LightSample {
@@ -105,6 +106,8 @@ struct ShapeSample {
     point: vec3f,
     normal: vec3f,
     density: f32,
+    // Mesh triangle: its barycentrics (b1, b2) at the point.
+    barycentrics: vec2f,
 }
 
 // CPU twin: `sample_shape`.
@@ -115,7 +118,7 @@ fn sample_shape(o: Object, primitive: u32, p: vec3f, u: vec2f, u_part: f32) -> S
     switch o.kind {
         case KIND_QUAD: {
             let n = cross(b, c);
-            return ShapeSample(a + u.x * b + u.y * c, normalize(n), 1.0 / length(n));
+            return ShapeSample(a + u.x * b + u.y * c, normalize(n), 1.0 / length(n), vec2f(0.0));
         }
         case KIND_SPHERE: {
             let radius = o.a.w;
@@ -130,10 +133,10 @@ fn sample_shape(o: Object, primitive: u32, p: vec3f, u: vec2f, u_part: f32) -> S
                     t = dot(a - p, dir);
                 }
                 let q = p + t * dir;
-                return ShapeSample(q, normalize(q - a), -1.0 / (TAU * one_minus_cos));
+                return ShapeSample(q, normalize(q - a), -1.0 / (TAU * one_minus_cos), vec2f(0.0));
             }
             let n = sample_uniform_sphere(u);
-            return ShapeSample(a + radius * n, n, 1.0 / (4.0 * PI * radius * radius));
+            return ShapeSample(a + radius * n, n, 1.0 / (4.0 * PI * radius * radius), vec2f(0.0));
         }
         case KIND_CYLINDER: {
             let radius = o.a.w;
@@ -146,12 +149,12 @@ fn sample_shape(o: Object, primitive: u32, p: vec3f, u: vec2f, u_part: f32) -> S
             if u_part * area < side || (o.flags & FLAG_CAPS) == 0u {
                 let phi = TAU * u.x;
                 let radial = frame[0] * cos(phi) + frame[1] * sin(phi);
-                return ShapeSample(a + axis * (u.y * height) + radial * radius, radial, 1.0 / area);
+                return ShapeSample(a + axis * (u.y * height) + radial * radius, radial, 1.0 / area, vec2f(0.0));
             }
             let top = u_part * area >= side + 0.5 * (area - side);
             let d = sample_disk(u) * radius;
             let center = select(a, b, top);
-            return ShapeSample(center + frame[0] * d.x + frame[1] * d.y, select(-axis, axis, top), 1.0 / area);
+            return ShapeSample(center + frame[0] * d.x + frame[1] * d.y, select(-axis, axis, top), 1.0 / area, vec2f(0.0));
         }
         default: {
             let i = 3u * primitive;
@@ -162,7 +165,7 @@ fn sample_shape(o: Object, primitive: u32, p: vec3f, u: vec2f, u_part: f32) -> S
             let b1 = 1.0 - su;
             let b2 = u.y * su;
             let n = cross(v1 - v0, v2 - v0);
-            return ShapeSample(v0 + b1 * (v1 - v0) + b2 * (v2 - v0), normalize(n), 2.0 / length(n));
+            return ShapeSample(v0 + b1 * (v1 - v0) + b2 * (v2 - v0), normalize(n), 2.0 / length(n), vec2f(b1, b2));
         }
     }
 }
@@ -215,6 +218,9 @@ fn sample_light(p: vec3f, n: vec3f, u_select: f32, u: vec2f) -> LightSample {
     } else {
         pdf = pmf * ss.density * distance * distance / cos_l;
     }
-    let radiance = materials[o.material].emission;
+    var radiance = materials[o.material].emission;
+    if o.kind == KIND_MESH {
+        radiance = material_at(materials[o.material], triangle_uv(light.primitive, ss.barycentrics.x, ss.barycentrics.y)).emission;
+    }
     return LightSample(wi, ss.point, true, radiance, pdf, pdf > 0.0 && pdf <= 3.0e38);
 }

@@ -8,6 +8,7 @@ const KIND_CYLINDER: u32 = 2u;
 const KIND_MESH: u32 = 3u;
 const FLAG_FLAT: u32 = 1u;
 const FLAG_CAPS: u32 = 2u;
+const FLAG_ALPHA: u32 = 4u;
 
 // One object, in the scene's order (a mesh's box is `a.xyz` to `b.xyz`). Host: `GpuObject`.
 struct Object {
@@ -53,11 +54,13 @@ struct WideNode {
 }
 
 // A triangle corner; triangle i is vertices 3i, 3i+1, 3i+2. Host: `GpuVertex`.
+// Normal and tangent are octahedral codes (`decode_unit` in surface.wgsl).
 struct Vertex {
     position: vec3f,
-    u: f32,
-    normal: vec3f,
-    v: f32,
+    normal: u32,
+    uv: vec2f,
+    tangent: u32,
+    tangent_sign: f32,
 }
 
 // A primitive of the BVH, in leaf order: a triangle with its corners (`triangle` is its
@@ -75,10 +78,32 @@ struct Primitive {
 const NO_TRIANGLE: u32 = 0xffffffffu;
 const SHAPE_LEAF: u32 = 0x80000000u;
 
-// Linear-RGB material with the seed's lobe weights. Host: `GpuMaterial`.
+const MODEL_LOBES: u32 = 0u;
+const MODEL_METAL_ROUGH: u32 = 1u;
+const MATERIAL_THIN: u32 = 1u;
+const MATERIAL_MASK: u32 = 2u;
+const MATERIAL_BLEND: u32 = 4u;
+const SLOT_BASE: u32 = 0u;
+const SLOT_METAL_ROUGH: u32 = 1u;
+const SLOT_NORMAL: u32 = 2u;
+const SLOT_EMISSION: u32 = 3u;
+const WRAP_REPEAT: u32 = 0u;
+const WRAP_CLAMP: u32 = 1u;
+const WRAP_MIRROR: u32 = 2u;
+
+// One use of a texture: texture coordinates (dot(u.xy, uv) + u.z, dot(v.xy, uv) + v.z), and
+// the WRAP_ modes of u (low 2 bits) and v. Host: `GpuTextureSlot`.
+struct TextureSlot {
+    u: vec3f,
+    texture: i32,
+    v: vec3f,
+    wrap: u32,
+}
+
+// Linear-RGB material: the seed's lobe weights or glTF's metal-rough model. Host: `GpuMaterial`.
 struct Material {
     base_color: vec3f,
-    texture: i32,
+    model: u32,
     emission: vec3f,
     specular_rate: f32,
     eta: vec3f,
@@ -90,9 +115,14 @@ struct Material {
     ior: f32,
     refract_roughness: f32,
     conductor: u32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
+    metallic: f32,
+    roughness: f32,
+    transmission: f32,
+    normal_scale: f32,
+    alpha_cutoff: f32,
+    alpha_factor: f32,
+    flags: u32,
+    slots: array<TextureSlot, 4>,
 }
 
 // Where a texture lies in `texels`. Host: `GpuTextureInfo`.

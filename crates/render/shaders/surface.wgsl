@@ -2,6 +2,7 @@
 // CPU twin: `crates/cpu/src/surface.rs`.
 
 #import scene
+#import textures
 #import intersect
 #import bvh
 #import sampling
@@ -17,42 +18,57 @@ struct Surface {
     material: u32,
 }
 
-// CPU twin: `srgb_to_linear`.
-fn srgb_to_linear(c: vec3f) -> vec3f {
-    let low = c / 12.92;
-    let high = pow((c + 0.055) / 1.055, vec3f(2.4));
-    return select(high, low, c <= vec3f(0.04045));
-}
-
-// CPU twin: `texel`.
-fn texel(info: TextureInfo, x: u32, y: u32) -> vec3f {
-    let packed = texels[info.offset + y * info.width + x];
-    return srgb_to_linear(unpack4x8unorm(packed).rgb);
-}
-
-// Bilinear lookup in linear RGB: u wraps, v clamps; v = 0 is the top row.
-// CPU twin: `sample_texture`.
-fn sample_texture(index: u32, uv: vec2f) -> vec3f {
-    let info = textures[index];
-    let size = vec2f(f32(info.width), f32(info.height));
-    let p = vec2f(fract(uv.x), clamp(uv.y, 0.0, 1.0)) * size - 0.5;
-    let f = fract(p);
-    let base = floor(p);
-    let x0 = u32(i32(base.x + size.x) % i32(info.width));
-    let x1 = (x0 + 1u) % info.width;
-    let y0 = u32(clamp(base.y, 0.0, size.y - 1.0));
-    let y1 = u32(clamp(base.y + 1.0, 0.0, size.y - 1.0));
-    let top = mix(texel(info, x0, y0), texel(info, x1, y0), f.x);
-    let bottom = mix(texel(info, x0, y1), texel(info, x1, y1), f.x);
-    return mix(top, bottom, f.y);
-}
-
-// CPU twin: `base_color`.
-fn base_color(material: Material, uv: vec2f) -> vec3f {
-    if material.texture >= 0 {
-        return sample_texture(u32(material.texture), uv);
+// The unit vector of an octahedral code; zero for the code 0x80008000.
+// CPU twin: `pathlight_core::octahedral::decode`.
+fn decode_unit(code: u32) -> vec3f {
+    if code == 0x80008000u {
+        return vec3f(0.0);
     }
-    return material.base_color;
+    let e = unpack2x16snorm(code);
+    let z = 1.0 - abs(e.x) - abs(e.y);
+    let t = max(-z, 0.0);
+    return normalize(vec3f(e.x + select(t, -t, e.x >= 0.0), e.y + select(t, -t, e.y >= 0.0), z));
+}
+
+// The material with its textures applied at `uv`: the lobes' base colour replaced by its
+// texture; the metal-rough base colour, metallic, roughness and emission multiplied by theirs.
+// CPU twin: `material_at`.
+fn material_at(material: Material, uv: vec2f) -> Material {
+    var m = material;
+    if m.slots[SLOT_BASE].texture >= 0 {
+        let color = srgb_to_linear(sample_slot(m.slots[SLOT_BASE], uv).rgb);
+        m.base_color = select(color, m.base_color * color, m.model == MODEL_METAL_ROUGH);
+    }
+    if m.model != MODEL_METAL_ROUGH {
+        return m;
+    }
+    if m.slots[SLOT_METAL_ROUGH].texture >= 0 {
+        let t = sample_slot(m.slots[SLOT_METAL_ROUGH], uv);
+        m.roughness *= t.g;
+        m.metallic *= t.b;
+    }
+    if m.slots[SLOT_EMISSION].texture >= 0 {
+        m.emission *= srgb_to_linear(sample_slot(m.slots[SLOT_EMISSION], uv).rgb);
+    }
+    return m;
+}
+
+// The shading normal `ns` bent by material `m`'s normal map at `uv`, in the frame of the
+// corner-interpolated tangent `tangent` (bitangent cross(ns, tangent) * sign).
+// CPU twin: `normal_mapped`.
+fn normal_mapped(m: Material, uv: vec2f, ns: vec3f, tangent: vec3f, sign: f32) -> vec3f {
+    let t = tangent - dot(tangent, ns) * ns;
+    if dot(t, t) < 1e-12 {
+        return ns;
+    }
+    let tn = normalize(t);
+    let b = cross(ns, tn) * sign;
+    let c = sample_slot(m.slots[SLOT_NORMAL], uv).xyz * 2.0 - 1.0;
+    let n = tn * (c.x * m.normal_scale) + b * (c.y * m.normal_scale) + ns * c.z;
+    if dot(n, n) < 1e-12 {
+        return ns;
+    }
+    return normalize(n);
 }
 
 // CPU twin: `surface_at`.
@@ -99,16 +115,21 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
             let v2 = vertices[i + 2u];
             let b0 = 1.0 - hit.b1 - hit.b2;
             s.ng = normalize(cross(v1.position - v0.position, v2.position - v0.position));
-            let n = b0 * v0.normal + hit.b1 * v1.normal + hit.b2 * v2.normal;
+            let n = b0 * decode_unit(v0.normal) + hit.b1 * decode_unit(v1.normal) + hit.b2 * decode_unit(v2.normal);
+            s.uv = b0 * v0.uv + hit.b1 * v1.uv + hit.b2 * v2.uv;
             if (o.flags & FLAG_FLAT) != 0u || dot(n, n) < 1e-12 {
                 s.ns = s.ng;
             } else {
                 s.ns = normalize(n);
-                if dot(s.ns, s.ng) < 0.0 {
-                    s.ns = -s.ns;
-                }
             }
-            s.uv = b0 * vec2f(v0.u, v0.v) + hit.b1 * vec2f(v1.u, v1.v) + hit.b2 * vec2f(v2.u, v2.v);
+            let m = materials[o.material];
+            if m.model == MODEL_METAL_ROUGH && m.slots[SLOT_NORMAL].texture >= 0 {
+                let tangent = b0 * decode_unit(v0.tangent) + hit.b1 * decode_unit(v1.tangent) + hit.b2 * decode_unit(v2.tangent);
+                s.ns = normal_mapped(m, s.uv, s.ns, tangent, v0.tangent_sign);
+            }
+            if dot(s.ns, s.ng) < 0.0 {
+                s.ns = -s.ns;
+            }
         }
     }
     return s;

@@ -13,8 +13,9 @@
 use std::fmt::Write as _;
 
 /// Every WGSL file of the crate, by the name imports use.
-pub const FILES: [(&str, &str); 13] = [
+pub const FILES: [(&str, &str); 14] = [
     ("scene", include_str!("../shaders/scene.wgsl")),
+    ("textures", include_str!("../shaders/textures.wgsl")),
     ("intersect", include_str!("../shaders/intersect.wgsl")),
     ("bvh", include_str!("../shaders/bvh.wgsl")),
     ("params", include_str!("../shaders/params.wgsl")),

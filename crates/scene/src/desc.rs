@@ -42,6 +42,21 @@ pub struct SceneDesc {
     /// Surfaces of revolution of a profile curve.
     #[serde(default)]
     pub revolve: Vec<Spanned<RevolveDesc>>,
+    /// glTF 2.0 files placed in the scene with their own materials.
+    #[serde(default)]
+    pub gltf: Vec<Spanned<GltfDesc>>,
+}
+
+/// A glTF 2.0 file (`.gltf` or `.glb`) placed in the scene: the triangles of its default
+/// scene with their materials (its cameras and punctual lights are not used).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GltfDesc {
+    /// The file, relative to the scene file.
+    pub file: String,
+    /// Placement in the world, applied after the file's own node transforms.
+    #[serde(default)]
+    pub transform: TransformDesc,
 }
 
 /// How `color` triples in the file are encoded.
@@ -180,6 +195,13 @@ pub struct MaterialDesc {
     /// Conductor Fresnel from a complex index of refraction: imaginary part per RGB channel.
     #[serde(default, deserialize_with = "exact::optional_array")]
     pub k: Option<[f32; 3]>,
+    /// glTF's metal-rough model instead of the lobes: 0 dielectric, 1 metal.
+    pub metallic: Option<f32>,
+    /// glTF's metal-rough model: perceptual roughness (GGX alpha = roughness^2).
+    pub roughness: Option<f32>,
+    /// glTF's metal-rough model: fraction of the dielectric base that transmits, through a
+    /// thin wall (`KHR_materials_transmission`).
+    pub transmission: Option<f32>,
 }
 
 fn default_color() -> [f32; 3] {

@@ -6,6 +6,7 @@ pub mod camera;
 pub mod default_scene;
 pub mod desc;
 pub mod environment;
+pub mod gltf_file;
 pub mod error;
 mod exact;
 pub mod load;
@@ -14,15 +15,17 @@ pub mod mesh;
 pub mod revolve;
 pub mod settings;
 pub mod shape;
+pub mod tangents;
 #[cfg(feature = "test-support")]
 pub mod testing;
 pub mod texture;
 
 pub use camera::Camera;
 pub use environment::{Environment, EnvironmentMap, HdrImage};
+pub use gltf_file::{GltfModel, gltf_scene, load_gltf};
 pub use error::{RangeError, SceneError};
 pub use load::{SceneSource, load_scene, load_scene_file};
-pub use material::{Conductor, Lobes, Material};
+pub use material::{AlphaMode, Conductor, Lobes, Material, MetalRough, TextureRef, Wrap};
 pub use settings::{RenderSettings, Sampler};
 pub use shape::{Object, Shape, TriangleMesh};
 pub use texture::Texture;

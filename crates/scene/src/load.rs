@@ -9,15 +9,17 @@ use glam::{Vec2, Vec3};
 use toml::Spanned;
 
 use crate::desc::{
-    ColorSpace, EnvironmentDesc, MaterialDesc, RenderDesc, SamplerDesc, SceneDesc, Shading,
+    ColorSpace, EnvironmentDesc, GltfDesc, MaterialDesc, RenderDesc, SamplerDesc, SceneDesc,
+    Shading,
 };
+use crate::gltf_file::load_gltf;
 use crate::error::SceneError;
 use crate::revolve::Revolution;
 use crate::settings::{MAX_COORDINATE, check_max_depth, check_resolution, check_spp};
 use crate::texture::srgb_to_linear;
 use crate::{
-    Camera, Conductor, Environment, HdrImage, Lobes, Material, Object, RenderSettings, Sampler,
-    Scene, Shape, Texture, TriangleMesh,
+    Camera, Conductor, Environment, HdrImage, Lobes, Material, MetalRough, Object, RenderSettings,
+    Sampler, Scene, Shape, Texture, TextureRef, TriangleMesh,
 };
 
 /// Where a scene's text and assets come from.
@@ -105,7 +107,10 @@ impl Builder<'_, '_> {
             material_ids.insert(name.clone(), materials.len() as u32);
             materials.push(self.material(name, material, desc.color_space)?);
         }
-        let objects = self.objects(&desc, &material_ids)?;
+        let mut objects = self.objects(&desc, &material_ids)?;
+        for gltf in &desc.gltf {
+            self.place_gltf(gltf, &mut materials, &mut objects)?;
+        }
         Ok(Scene {
             camera,
             settings,
@@ -317,6 +322,9 @@ impl Builder<'_, '_> {
             Some(e) => self.radiance(span.clone(), &key("emission"), e)?,
             None => Vec3::ZERO,
         };
+        if m.metallic.is_some() || m.roughness.is_some() || m.transmission.is_some() {
+            return self.metal_rough_material(name, m, base_color, emission, span);
+        }
         let conductor = match (&m.conductor, m.eta, m.k) {
             (None, None, None) => None,
             (Some(preset), None, None) => Some(Conductor::preset(preset).ok_or_else(|| {
@@ -380,7 +388,11 @@ impl Builder<'_, '_> {
             return Err(self.invalid(span, format!("{} = {ior} must be > 0", key("ior"))));
         }
         let texture = match &m.texture {
-            Some(path) => Some(self.texture(span.clone(), &key("texture"), path)?),
+            Some(path) => Some(TextureRef::plain(self.texture(
+                span.clone(),
+                &key("texture"),
+                path,
+            )?)),
             None => None,
         };
         let lobes = Lobes {
@@ -415,7 +427,106 @@ impl Builder<'_, '_> {
             emission,
             lobes,
             conductor,
+            metal_rough: None,
         })
+    }
+
+    /// A material with `metallic`, `roughness` or `transmission`: glTF's metal-rough model,
+    /// which takes none of the lobe keys.
+    fn metal_rough_material(
+        &mut self,
+        name: &str,
+        m: &MaterialDesc,
+        base_color: Vec3,
+        emission: Vec3,
+        span: Range<usize>,
+    ) -> Result<Material, SceneError> {
+        let key = |k: &str| format!("materials.{name}.{k}");
+        let lobe_keys = [
+            ("preset", m.preset.is_some()),
+            ("specular_rate", m.specular_rate.is_some()),
+            ("specular_tint", m.specular_tint.is_some()),
+            ("specular_roughness", m.specular_roughness.is_some()),
+            ("refract_rate", m.refract_rate.is_some()),
+            ("refract_tint", m.refract_tint.is_some()),
+            ("refract_roughness", m.refract_roughness.is_some()),
+            ("conductor", m.conductor.is_some() || m.eta.is_some() || m.k.is_some()),
+        ];
+        if let Some((lobe_key, _)) = lobe_keys.iter().find(|(_, given)| *given) {
+            return Err(self.invalid(
+                span,
+                format!(
+                    "{}: the metal-rough model (metallic, roughness, transmission) takes no `{lobe_key}`",
+                    key(lobe_key)
+                ),
+            ));
+        }
+        let ior = m.ior.unwrap_or(1.5);
+        if !(ior.is_finite() && ior >= 1.0) {
+            return Err(self.invalid(span, format!("{} = {ior} must be >= 1", key("ior"))));
+        }
+        let texture = match &m.texture {
+            Some(path) => Some(TextureRef::plain(self.texture(
+                span.clone(),
+                &key("texture"),
+                path,
+            )?)),
+            None => None,
+        };
+        Ok(Material {
+            name: name.to_owned(),
+            base_color,
+            texture,
+            emission,
+            lobes: Lobes::DIFFUSE,
+            conductor: None,
+            metal_rough: Some(MetalRough {
+                metallic: self.unit(span.clone(), &key("metallic"), m.metallic.unwrap_or(0.0))?,
+                roughness: self.unit(span.clone(), &key("roughness"), m.roughness.unwrap_or(1.0))?,
+                transmission: self.unit(span, &key("transmission"), m.transmission.unwrap_or(0.0))?,
+                ior,
+                ..MetalRough::DEFAULT
+            }),
+        })
+    }
+
+    /// Adds the objects, materials and textures of a `[[gltf]]` entry.
+    fn place_gltf(
+        &mut self,
+        desc: &Spanned<GltfDesc>,
+        materials: &mut Vec<Material>,
+        objects: &mut Vec<Object>,
+    ) -> Result<(), SceneError> {
+        let d = desc.get_ref();
+        let path = self.source.base_dir.join(&d.file);
+        let model = load_gltf(&path, d.transform.to_matrix()).map_err(|err| match err {
+            SceneError::Io { path, source } => self.invalid(
+                desc.span(),
+                format!("gltf.file: cannot read {}: {source}", path.display()),
+            ),
+            other => other,
+        })?;
+        let (first_material, first_texture) = (materials.len() as u32, self.textures.len() as u32);
+        let shift = |r: &mut Option<TextureRef>| {
+            if let Some(r) = r {
+                r.texture += first_texture;
+            }
+        };
+        for mut material in model.materials {
+            shift(&mut material.texture);
+            if let Some(pbr) = &mut material.metal_rough {
+                shift(&mut pbr.metal_rough_texture);
+                shift(&mut pbr.normal_texture);
+                shift(&mut pbr.emission_texture);
+            }
+            materials.push(material);
+        }
+        self.textures.extend(model.textures);
+        objects.extend(model.objects.into_iter().map(|o| Object {
+            material: o.material + first_material,
+            ..o
+        }));
+        Ok(())
     }
 
     /// Reads an asset named in the file: embedded first, else relative to the scene.

@@ -1,6 +1,6 @@
 //! The geometry of the scene's objects.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 /// A triangle mesh in world space.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -13,6 +13,10 @@ pub struct TriangleMesh {
     pub uvs: Vec<Vec2>,
     /// Triangles as indices into the vertex arrays.
     pub indices: Vec<[u32; 3]>,
+    /// Per triangle corner (three per triangle, in `indices` order), the tangent along
+    /// +u and in `w` the sign of the bitangent (`cross(normal, tangent) * w` points along
+    /// +v); empty when no material of the mesh needs them (normal maps do).
+    pub tangents: Vec<Vec4>,
     /// Shade with the geometric normal instead of `normals`.
     pub flat: bool,
 }

@@ -39,6 +39,7 @@ pub fn scene_of(objects: Vec<Object>) -> Scene {
             emission: Vec3::ZERO,
             lobes: Lobes::DIFFUSE,
             conductor: None,
+            metal_rough: None,
         }],
         textures: Vec::new(),
         objects,

@@ -80,7 +80,7 @@ impl LightSwitch {
                 Vec3::ZERO
             } else {
                 let color = match own.texture {
-                    Some(t) => scene.textures[t as usize].mean_linear(),
+                    Some(t) => scene.textures[t.texture as usize].mean_linear(),
                     None => own.base_color,
                 };
                 color * self.strength

@@ -1,0 +1,91 @@
+// Texture lookups through a material's texture slots, and the alpha test of cut-out
+// triangles that the traversal calls. CPU twin: `crates/cpu/src/textures.rs`.
+
+#import scene
+
+// CPU twin: `srgb_to_linear`.
+fn srgb_to_linear(c: vec3f) -> vec3f {
+    let low = c / 12.92;
+    let high = pow((c + 0.055) / 1.055, vec3f(2.4));
+    return select(high, low, c <= vec3f(0.04045));
+}
+
+// CPU twin: `texel`.
+fn texel(info: TextureInfo, x: u32, y: u32) -> vec4f {
+    return unpack4x8unorm(texels[info.offset + y * info.width + x]);
+}
+
+// A coordinate folded into [0, 1] by wrap mode `mode`.
+// CPU twin: `wrap`.
+fn wrap_coordinate(x: f32, mode: u32) -> f32 {
+    if mode == WRAP_CLAMP {
+        return clamp(x, 0.0, 1.0);
+    }
+    if mode == WRAP_MIRROR {
+        let t = fract(x * 0.5) * 2.0;
+        return select(t, 2.0 - t, t > 1.0);
+    }
+    return fract(x);
+}
+
+// Index of the texel at `i` along a side of `n` texels: tiled by WRAP_REPEAT, else clamped.
+// CPU twin: `texel_index`.
+fn texel_index(i: f32, n: u32, mode: u32) -> u32 {
+    if mode == WRAP_REPEAT {
+        return u32(i32(i + f32(n)) % i32(n));
+    }
+    return u32(clamp(i, 0.0, f32(n) - 1.0));
+}
+
+// Bilinear RGBA lookup, as stored (sRGB colour channels are not decoded); row 0 is v = 0.
+// CPU twin: `sample_slot`.
+fn sample_slot(slot: TextureSlot, uv: vec2f) -> vec4f {
+    let info = textures[u32(slot.texture)];
+    let mode_u = slot.wrap & 3u;
+    let mode_v = (slot.wrap >> 2u) & 3u;
+    let t = vec2f(dot(slot.u.xy, uv) + slot.u.z, dot(slot.v.xy, uv) + slot.v.z);
+    let size = vec2f(f32(info.width), f32(info.height));
+    let p = vec2f(wrap_coordinate(t.x, mode_u), wrap_coordinate(t.y, mode_v)) * size - 0.5;
+    let f = fract(p);
+    let base = floor(p);
+    let x0 = texel_index(base.x, info.width, mode_u);
+    let x1 = texel_index(base.x + 1.0, info.width, mode_u);
+    let y0 = texel_index(base.y, info.height, mode_v);
+    let y1 = texel_index(base.y + 1.0, info.height, mode_v);
+    let top = mix(texel(info, x0, y0), texel(info, x1, y0), f.x);
+    let bottom = mix(texel(info, x0, y1), texel(info, x1, y1), f.x);
+    return mix(top, bottom, f.y);
+}
+
+// Texture coordinates at barycentrics (b1, b2) of triangle `triangle`.
+// CPU twin: `triangle_uv`.
+fn triangle_uv(triangle: u32, b1: f32, b2: f32) -> vec2f {
+    let i = 3u * triangle;
+    return (1.0 - b1 - b2) * vertices[i].uv + b1 * vertices[i + 1u].uv + b2 * vertices[i + 2u].uv;
+}
+
+// A number in [0, 1) fixed by a triangle and a hit distance: the threshold of stochastic
+// (BLEND) transparency, the same for every query of the same ray.
+// CPU twin: `blend_threshold`.
+fn blend_threshold(triangle: u32, t: f32) -> f32 {
+    var h = triangle * 0x9e3779b9u ^ bitcast<u32>(t);
+    h = (h ^ (h >> 16u)) * 0x7feb352du;
+    h = (h ^ (h >> 15u)) * 0x846ca68bu;
+    h = h ^ (h >> 16u);
+    return f32(h >> 8u) * (1.0 / 16777216.0);
+}
+
+// Whether a ray stops at (b1, b2), distance t, on triangle `triangle` of `object` (whose
+// material has alpha holes): its alpha reaches the cutoff (MASK) or the blend threshold.
+// CPU twin: `alpha_stops`.
+fn alpha_stops(object: u32, triangle: u32, b1: f32, b2: f32, t: f32) -> bool {
+    let m = materials[objects[object].material];
+    var alpha = m.alpha_factor;
+    if m.slots[SLOT_BASE].texture >= 0 {
+        alpha *= sample_slot(m.slots[SLOT_BASE], triangle_uv(triangle, b1, b2)).a;
+    }
+    if (m.flags & MATERIAL_MASK) != 0u {
+        return alpha >= m.alpha_cutoff;
+    }
+    return alpha > blend_threshold(triangle, t);
+}

@@ -1,0 +1,319 @@
+//! glTF 2.0 import (`.gltf` with its buffers and images, `.glb`, `data:` URIs): the
+//! triangles of every node of the default scene in world space, their metal-rough
+//! materials and textures, and the scene's perspective cameras. Malformed files are refused
+//! naming the element (mesh, primitive, accessor, buffer, image, node); points and lines
+//! are skipped with a warning.
+
+mod data;
+mod materials;
+mod primitives;
+
+use std::path::Path;
+
+use glam::{Mat4, Vec3};
+
+use crate::desc::RenderDesc;
+use crate::error::SceneError;
+use crate::settings::MAX_COORDINATE;
+use crate::{Camera, Environment, Material, Object, RenderSettings, Scene, Shape, Texture};
+use data::Files;
+use materials::Materials;
+
+/// Deepest node nesting accepted.
+const MAX_DEPTH: usize = 256;
+/// Most mesh instances accepted (a node shared by many parents is placed once per path).
+const MAX_INSTANCES: usize = 1 << 20;
+/// Radiance of the grey sky that lights a model whose file has no emitters.
+pub const GREY_SKY: f32 = 0.8;
+
+/// A perspective camera of a glTF file, placed in the world.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GltfCamera {
+    /// Eye position.
+    pub position: Vec3,
+    /// Unit view direction (the camera's -z).
+    pub forward: Vec3,
+    /// Unit up direction (the camera's +y).
+    pub up: Vec3,
+    /// Full vertical field of view, degrees.
+    pub fov_y_deg: f32,
+    /// Width over height, when the file gives it.
+    pub aspect: Option<f32>,
+}
+
+/// What a glTF file adds to a scene. Material indices count from 0 within `materials`,
+/// and texture indices within `textures`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GltfModel {
+    /// One mesh object per placed primitive.
+    pub objects: Vec<Object>,
+    /// The materials the objects use.
+    pub materials: Vec<Material>,
+    /// The images the materials use.
+    pub textures: Vec<Texture>,
+    /// Perspective cameras in node order.
+    pub cameras: Vec<GltfCamera>,
+}
+
+impl GltfModel {
+    /// The box around every vertex: (min, max).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.objects
+            .iter()
+            .filter_map(|o| match &o.shape {
+                Shape::Mesh(m) => Some(&m.positions),
+                _ => None,
+            })
+            .flatten()
+            .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+    }
+
+    /// Whether any material emits.
+    pub fn has_emitters(&self) -> bool {
+        self.materials.iter().any(|m| m.emission.max_element() > 0.0)
+    }
+}
+
+/// Reads the glTF file `path` and places its default scene (or its first) by `transform`.
+pub fn load_gltf(path: &Path, transform: Mat4) -> Result<GltfModel, SceneError> {
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    let files = Files {
+        path,
+        base: path.parent().map(Path::to_owned).unwrap_or_default(),
+    };
+    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(&bytes).map_err(|err| {
+        SceneError::Asset {
+            path: path.to_owned(),
+            message: format!("not a valid glTF file: {err}"),
+        }
+    })?;
+    if document.extensions_used().any(|e| e == "KHR_draco_mesh_compression") {
+        return Err(files.error("extensionsUsed", "Draco-compressed meshes are not supported"));
+    }
+    if document.lights().is_some_and(|mut l| l.next().is_some()) {
+        log::warn!(
+            "{}: its punctual lights (KHR_lights_punctual) are ignored; only emissive materials and the environment light",
+            path.display()
+        );
+    }
+    let buffers = files.buffers(&document, blob)?;
+    let scene = document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+        .ok_or_else(|| files.error("scenes", "the file holds no scene"))?;
+    let mut walk = Walk {
+        files: &files,
+        buffers: &buffers,
+        materials: Materials::new(),
+        model: GltfModel {
+            objects: Vec::new(),
+            materials: Vec::new(),
+            textures: Vec::new(),
+            cameras: Vec::new(),
+        },
+        ancestors: Vec::new(),
+        instances: 0,
+        stem: path
+            .file_stem()
+            .map_or_else(|| "gltf".to_owned(), |s| s.to_string_lossy().into_owned()),
+    };
+    for node in scene.nodes() {
+        walk.node(&node, transform)?;
+    }
+    if walk.model.objects.is_empty() {
+        return Err(files.error(
+            &format!("scene {}", scene.index()),
+            "holds no triangles to render",
+        ));
+    }
+    walk.model.materials = walk.materials.materials;
+    walk.model.textures = walk.materials.textures;
+    Ok(walk.model)
+}
+
+/// The depth-first walk over a scene's nodes.
+struct Walk<'a> {
+    files: &'a Files<'a>,
+    buffers: &'a [Vec<u8>],
+    materials: Materials,
+    model: GltfModel,
+    /// The nodes above the current one (a node among them again is a cycle).
+    ancestors: Vec<usize>,
+    instances: usize,
+    /// The file's name without extension, prefixing object names.
+    stem: String,
+}
+
+impl Walk<'_> {
+    fn node(&mut self, node: &gltf::Node, parent: Mat4) -> Result<(), SceneError> {
+        let element = format!("node {}", node.index());
+        if self.ancestors.contains(&node.index()) {
+            return Err(self.files.error(&element, "is its own ancestor (the node hierarchy has a cycle)"));
+        }
+        if self.ancestors.len() >= MAX_DEPTH {
+            return Err(self.files.error(&element, format!("nodes nest deeper than {MAX_DEPTH}")));
+        }
+        let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+        let world = parent * local;
+        if !world.is_finite() || world.abs().to_cols_array().iter().any(|&v| v > MAX_COORDINATE) {
+            return Err(self.files.error(&element, "its transform is not finite"));
+        }
+        if let Some(camera) = node.camera() {
+            self.camera(&camera, world);
+        }
+        if let Some(mesh) = node.mesh() {
+            self.instances += 1;
+            if self.instances > MAX_INSTANCES {
+                return Err(self.files.error(
+                    &element,
+                    format!("the scene places more than {MAX_INSTANCES} meshes"),
+                ));
+            }
+            self.mesh(&mesh, world)?;
+        }
+        self.ancestors.push(node.index());
+        for child in node.children() {
+            self.node(&child, world)?;
+        }
+        self.ancestors.pop();
+        Ok(())
+    }
+
+    fn camera(&mut self, camera: &gltf::Camera, world: Mat4) {
+        let gltf::camera::Projection::Perspective(p) = camera.projection() else {
+            log::warn!(
+                "{}: camera {} is orthographic and is skipped",
+                self.files.path.display(),
+                camera.index()
+            );
+            return;
+        };
+        let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+        let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+        let fov = p.yfov().to_degrees();
+        if forward == Vec3::ZERO || up.cross(forward) == Vec3::ZERO || !(fov > 0.0 && fov < 180.0) {
+            log::warn!(
+                "{}: camera {} has a degenerate placement or field of view and is skipped",
+                self.files.path.display(),
+                camera.index()
+            );
+            return;
+        }
+        self.model.cameras.push(GltfCamera {
+            position: world.transform_point3(Vec3::ZERO),
+            forward,
+            up,
+            fov_y_deg: fov,
+            aspect: p.aspect_ratio().filter(|a| a.is_finite() && *a > 0.0),
+        });
+    }
+
+    fn mesh(&mut self, mesh: &gltf::Mesh, world: Mat4) -> Result<(), SceneError> {
+        for primitive in mesh.primitives() {
+            let (material, needs) =
+                self.materials
+                    .get(self.files, self.buffers, &primitive.material())?;
+            let Some(mut triangles) = primitives::read_primitive(
+                self.files,
+                self.buffers,
+                mesh.index(),
+                &primitive,
+                needs,
+            )?
+            else {
+                continue;
+            };
+            primitives::place(&mut triangles, world);
+            let name = format!(
+                "{}/{}#{}.{}",
+                self.stem,
+                mesh.name().map_or_else(|| format!("mesh{}", mesh.index()), str::to_owned),
+                primitive.index(),
+                self.instances
+            );
+            self.model.objects.push(Object {
+                name,
+                material,
+                shape: Shape::Mesh(triangles),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// A scene of the glTF file `path` alone: its camera `camera` (else its first, else one
+/// framing the model from the front and a little above), its emitters or, with none, a
+/// uniform grey sky of radiance [`GREY_SKY`], and the default render settings.
+pub fn gltf_scene(path: &Path, camera: Option<usize>) -> Result<Scene, SceneError> {
+    let model = load_gltf(path, Mat4::IDENTITY)?;
+    let height = 720;
+    let camera = match camera {
+        Some(n) => {
+            let c = model.cameras.get(n).ok_or_else(|| SceneError::Asset {
+                path: path.to_owned(),
+                message: format!(
+                    "has no camera {n}: it has {} perspective camera(s), numbered from 0",
+                    model.cameras.len()
+                ),
+            })?;
+            file_camera(c, height)
+        }
+        None => match model.cameras.first() {
+            Some(c) => file_camera(c, height),
+            None => framing_camera(model.bounds(), height),
+        },
+    };
+    let environment = if model.has_emitters() {
+        Environment::Constant(Vec3::ZERO)
+    } else {
+        Environment::Constant(Vec3::splat(GREY_SKY))
+    };
+    Ok(Scene {
+        camera,
+        settings: RenderSettings::from(&RenderDesc::default()),
+        environment,
+        materials: model.materials,
+        textures: model.textures,
+        objects: model.objects,
+    })
+}
+
+/// The camera of the file, its image `height` pixels high and as wide as its aspect ratio
+/// (16:9 when it gives none).
+fn file_camera(c: &GltfCamera, height: u32) -> Camera {
+    let aspect = c.aspect.unwrap_or(16.0 / 9.0).clamp(0.1, 10.0);
+    Camera {
+        position: c.position,
+        look_at: c.position + c.forward,
+        up: c.up,
+        fov_y_deg: c.fov_y_deg,
+        width: ((height as f32 * aspect).round() as u32).max(1),
+        height,
+        aperture_radius: 0.0,
+        focus_distance: 1.0,
+    }
+}
+
+/// A 16:9 camera with a 40 degree vertical field of view looking at the centre of `bounds`
+/// along -z from a little above, far enough that the box's bounding sphere fits the view.
+pub fn framing_camera(bounds: (Vec3, Vec3), height: u32) -> Camera {
+    let (lo, hi) = bounds;
+    let center = 0.5 * (lo + hi);
+    let radius = (0.5 * (hi - lo).length()).max(1e-3);
+    let fov_y_deg = 40.0f32;
+    let distance = radius / (0.5 * fov_y_deg.to_radians()).sin();
+    let direction = Vec3::new(0.0, 0.35, 1.0).normalize();
+    Camera {
+        position: center + distance * direction,
+        look_at: center,
+        up: Vec3::Y,
+        fov_y_deg,
+        width: height * 16 / 9,
+        height,
+        aperture_radius: 0.0,
+        focus_distance: distance,
+    }
+}
