@@ -6,7 +6,9 @@
 use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3A};
-use pathlight_core::gpu_types::GpuMaterial;
+use pathlight_core::gpu_types::{
+    GpuMaterial, GpuTextureSlot, MATERIAL_THIN, MODEL_LOBES, MODEL_METAL_ROUGH,
+};
 use pathlight_cpu::bsdf::{eval_bsdf, fresnel_conductor, fresnel_dielectric, ggx_d, sample_bsdf};
 use pathlight_cpu::sampling::sample_uniform_sphere;
 use pathlight_cpu::surface::Surface;
@@ -24,7 +26,7 @@ fn material(
 ) -> GpuMaterial {
     GpuMaterial {
         base_color: [1.0; 3],
-        texture: -1,
+        model: MODEL_LOBES,
         emission: [0.0; 3],
         specular_rate: specular,
         eta: [0.143_036, 0.375_307, 1.442_05],
@@ -36,7 +38,33 @@ fn material(
         ior: 1.5,
         refract_roughness: refract_rough,
         conductor: u32::from(conductor),
-        pad: [0; 3],
+        metallic: 0.0,
+        roughness: 0.0,
+        transmission: 0.0,
+        normal_scale: 1.0,
+        alpha_cutoff: 0.0,
+        alpha_factor: 1.0,
+        flags: 0,
+        slots: [GpuTextureSlot {
+            u: [1.0, 0.0, 0.0],
+            texture: -1,
+            v: [0.0, 1.0, 0.0],
+            wrap: 0,
+        }; 4],
+    }
+}
+
+/// glTF's metal-rough model: base colour, metallic, roughness, transmission (thin wall or
+/// solid).
+fn metal_rough(color: [f32; 3], metallic: f32, roughness: f32, transmission: f32, thin: bool) -> GpuMaterial {
+    GpuMaterial {
+        base_color: color,
+        model: MODEL_METAL_ROUGH,
+        metallic,
+        roughness,
+        transmission,
+        flags: if thin { MATERIAL_THIN } else { 0 },
+        ..material(0.0, 0.0, 0.0, 0.0, false)
     }
 }
 
@@ -58,6 +86,15 @@ fn cases() -> Vec<(&'static str, GpuMaterial)> {
             "rough glass over diffuse",
             material(0.0, 0.0, 0.6, 0.3, false),
         ),
+        ("metal-rough white dielectric, rough", metal_rough([1.0; 3], 0.0, 1.0, 0.0, true)),
+        ("metal-rough white dielectric, glossy", metal_rough([1.0; 3], 0.0, 0.3, 0.0, true)),
+        ("metal-rough smooth dielectric", metal_rough([1.0; 3], 0.0, 0.0, 0.0, true)),
+        ("metal-rough coloured metal", metal_rough([0.9, 0.6, 0.2], 1.0, 0.5, 0.0, true)),
+        ("metal-rough half metal", metal_rough([0.5, 0.8, 1.0], 0.5, 0.2, 0.0, true)),
+        ("metal-rough thin rough wall", metal_rough([1.0; 3], 0.0, 0.4, 1.0, true)),
+        ("metal-rough thin smooth wall", metal_rough([0.8, 1.0, 0.9], 0.0, 0.0, 0.7, true)),
+        ("metal-rough solid rough glass", metal_rough([1.0; 3], 0.0, 0.5, 1.0, false)),
+        ("metal-rough solid smooth glass", metal_rough([1.0; 3], 0.0, 0.0, 0.6, false)),
     ]
 }
 
@@ -212,7 +249,9 @@ fn no_material_creates_energy() {
                 .collect();
             let (mean, error) = mean_and_error(&weights);
             // Refraction scales radiance by 1/eta^2 going in and eta^2 coming out.
-            let bound = if wo.z < 0.0 && m.refract_rate > 0.0 {
+            let solid = m.refract_rate > 0.0
+                || (m.model == MODEL_METAL_ROUGH && m.transmission > 0.0 && m.flags & MATERIAL_THIN == 0);
+            let bound = if wo.z < 0.0 && solid {
                 2.25
             } else {
                 1.0
@@ -272,4 +311,65 @@ fn fresnel_and_ggx_closed_forms() {
             "alpha {alpha}: {mean}"
         );
     }
+}
+
+/// The metal-rough model reflects no more than it receives at any roughness, metallic and
+/// colour, from any direction (5-sigma bound on the mean sampled weight).
+#[test]
+fn metal_rough_never_gains_energy() {
+    let mut rng = StdRng::seed_from_u64(7);
+    for roughness in [0.0, 0.05, 0.2, 0.5, 0.8, 1.0] {
+        for metallic in [0.0, 0.5, 1.0] {
+            for color in [[1.0; 3], [0.9, 0.4, 0.1]] {
+                let m = metal_rough(color, metallic, roughness, 0.0, true);
+                for wo in outgoing().into_iter().filter(|w| w.z > 0.0) {
+                    let weights: Vec<f64> = (0..N / 10)
+                        .map(|_| {
+                            let bs = sample(&mut rng, &m, wo);
+                            if bs.valid {
+                                f64::from(bs.weight.max_element())
+                            } else {
+                                0.0
+                            }
+                        })
+                        .collect();
+                    let (mean, error) = mean_and_error(&weights);
+                    assert!(
+                        mean <= 1.0 + 5.0 * error + 1e-4,
+                        "roughness {roughness}, metallic {metallic}, colour {color:?}, wo {wo}: albedo {mean} +- {error}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// Metallic 1 is a GGX conductor with Schlick's Fresnel from F0 = base colour:
+/// f cos_i = D G1(wo) G1(wi) F / (4 cos_o) exactly, and a smooth one reflects F(cos_o).
+#[test]
+fn metallic_one_is_a_schlick_conductor() {
+    let f0 = Vec3A::new(0.95, 0.64, 0.54);
+    let m = metal_rough(f0.to_array(), 1.0, 0.6, 0.0, true);
+    let alpha = 0.36f32;
+    let wo = Vec3A::new(0.6, 0.0, 0.8);
+    let wi = Vec3A::new(-0.3, 0.4, 0.866).normalize();
+    let h = (wo + wi).normalize();
+    let g1 = |w: Vec3A| {
+        let tan2 = (w.x * w.x + w.y * w.y) / (w.z * w.z);
+        2.0 / (1.0 + (1.0 + alpha * alpha * tan2).sqrt())
+    };
+    let schlick = f0 + (Vec3A::ONE - f0) * (1.0 - wo.dot(h)).powi(5);
+    let expected = ggx_d(h, alpha) * g1(wo) * g1(wi) * schlick / (4.0 * wo.z);
+    let e = eval_bsdf(&m, f0, &surface(), wo, wi);
+    assert!(
+        (e.f - expected).abs().max_element() < 1e-5,
+        "{} vs {expected}",
+        e.f
+    );
+    let smooth = metal_rough(f0.to_array(), 1.0, 0.0, 0.0, true);
+    let mut rng = StdRng::seed_from_u64(8);
+    let bs = sample(&mut rng, &smooth, wo);
+    assert!(bs.delta && bs.valid);
+    let reflected = f0 + (Vec3A::ONE - f0) * (1.0 - wo.z).powi(5);
+    assert!((bs.weight - reflected).abs().max_element() < 1e-5, "{}", bs.weight);
 }

@@ -56,7 +56,8 @@ fn material_at(material: Material, uv: vec2f) -> Material {
 // The shading normal `ns` bent by material `m`'s normal map at `uv`, in the frame of the
 // corner-interpolated tangent `tangent` (bitangent cross(ns, tangent) * sign).
 // CPU twin: `normal_mapped`.
-fn normal_mapped(m: Material, uv: vec2f, ns: vec3f, tangent: vec3f, sign: f32) -> vec3f {
+fn normal_mapped(material: u32, uv: vec2f, ns: vec3f, tangent: vec3f, sign: f32) -> vec3f {
+    let m = materials[material];
     let t = tangent - dot(tangent, ns) * ns;
     if dot(t, t) < 1e-12 {
         return ns;
@@ -122,10 +123,9 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
             } else {
                 s.ns = normalize(n);
             }
-            let m = materials[o.material];
-            if m.model == MODEL_METAL_ROUGH && m.slots[SLOT_NORMAL].texture >= 0 {
+            if materials[o.material].model == MODEL_METAL_ROUGH && materials[o.material].slots[SLOT_NORMAL].texture >= 0 {
                 let tangent = b0 * decode_unit(v0.tangent) + hit.b1 * decode_unit(v1.tangent) + hit.b2 * decode_unit(v2.tangent);
-                s.ns = normal_mapped(m, s.uv, s.ns, tangent, v0.tangent_sign);
+                s.ns = normal_mapped(o.material, s.uv, s.ns, tangent, v0.tangent_sign);
             }
             if dot(s.ns, s.ng) < 0.0 {
                 s.ns = -s.ns;

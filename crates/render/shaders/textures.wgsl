@@ -79,13 +79,13 @@ fn blend_threshold(triangle: u32, t: f32) -> f32 {
 // material has alpha holes): its alpha reaches the cutoff (MASK) or the blend threshold.
 // CPU twin: `alpha_stops`.
 fn alpha_stops(object: u32, triangle: u32, b1: f32, b2: f32, t: f32) -> bool {
-    let m = materials[objects[object].material];
-    var alpha = m.alpha_factor;
-    if m.slots[SLOT_BASE].texture >= 0 {
-        alpha *= sample_slot(m.slots[SLOT_BASE], triangle_uv(triangle, b1, b2)).a;
+    let m = objects[object].material;
+    var alpha = materials[m].alpha_factor;
+    if materials[m].slots[SLOT_BASE].texture >= 0 {
+        alpha *= sample_slot(materials[m].slots[SLOT_BASE], triangle_uv(triangle, b1, b2)).a;
     }
-    if (m.flags & MATERIAL_MASK) != 0u {
-        return alpha >= m.alpha_cutoff;
+    if (materials[m].flags & MATERIAL_MASK) != 0u {
+        return alpha >= materials[m].alpha_cutoff;
     }
     return alpha > blend_threshold(triangle, t);
 }

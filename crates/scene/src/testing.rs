@@ -261,6 +261,7 @@ pub fn icosphere(subdivisions: u32) -> TriangleMesh {
         uvs: vec![Vec2::ZERO; positions.len()],
         positions,
         indices: faces,
+        tangents: Vec::new(),
         flat: false,
     }
 }

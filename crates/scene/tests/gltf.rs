@@ -1,0 +1,310 @@
+//! glTF import: the samples of Debian's `assimp-testmodels` (`tests/data/gltf`, provenance
+//! in its README) load with the right geometry, cameras and materials, every malformed one
+//! is refused naming the element, and hand-made files check node transforms, texture
+//! transforms, data URIs and `[[gltf]]` in a scene file.
+
+use std::path::{Path, PathBuf};
+
+use base64::Engine;
+use glam::{Mat4, Quat, Vec3};
+use pathlight_scene::{
+    AlphaMode, Environment, Scene, SceneSource, Shape, TriangleMesh, gltf_scene, load_gltf,
+    load_scene,
+};
+
+fn data(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gltf").join(path)
+}
+
+fn meshes(scene: &Scene) -> Vec<&TriangleMesh> {
+    scene
+        .objects
+        .iter()
+        .filter_map(|o| match &o.shape {
+            Shape::Mesh(m) => Some(m),
+            _ => None,
+        })
+        .collect()
+}
+
+fn area(mesh: &TriangleMesh) -> f32 {
+    mesh.indices
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            0.5 * (b - a).cross(c - a).length()
+        })
+        .sum()
+}
+
+#[test]
+fn the_textured_box_loads_from_glb_and_from_data_uris_alike() {
+    let glb = gltf_scene(&data("BoxTextured-glTF-Binary/BoxTextured.glb"), None).unwrap();
+    let embedded = gltf_scene(&data("BoxTextured-glTF-Embedded/BoxTextured.gltf"), None).unwrap();
+    for scene in [&glb, &embedded] {
+        let meshes = meshes(scene);
+        assert_eq!(meshes.len(), 1);
+        assert_eq!(meshes[0].indices.len(), 12, "a box has 12 triangles");
+        // A unit cube: 6 square faces of area 1.
+        assert!((area(meshes[0]) - 6.0).abs() < 1e-4, "{}", area(meshes[0]));
+        assert_eq!(scene.materials.len(), 1);
+        let texture = scene.materials[0].texture.expect("a base colour texture");
+        let image = &scene.textures[texture.texture as usize];
+        assert_eq!((image.width, image.height), (211, 211));
+        // No light in the file: the grey sky lights it.
+        assert_eq!(scene.environment, Environment::Constant(Vec3::splat(0.8)));
+    }
+    assert_eq!(meshes(&glb)[0].positions, meshes(&embedded)[0].positions);
+    assert_eq!(glb.textures, embedded.textures);
+}
+
+#[test]
+fn a_model_without_cameras_is_framed_from_the_front() {
+    let scene = gltf_scene(&data("BoxTextured-glTF-Binary/BoxTextured.glb"), None).unwrap();
+    let c = &scene.camera;
+    // The unit cube's centre is the origin; the camera looks at it from +z and above,
+    // far enough that its bounding sphere (radius sqrt(3)/2) fills the 40 degree view.
+    assert!(c.look_at.length() < 1e-5, "{}", c.look_at);
+    let distance = c.position.length();
+    let expected = 0.75f32.sqrt() / 20f32.to_radians().sin();
+    assert!((distance - expected).abs() < 1e-4, "{distance} vs {expected}");
+    assert!(c.position.z > 0.0 && c.position.y > 0.0);
+    assert_eq!((c.width, c.height), (1280, 720));
+}
+
+#[test]
+fn the_first_perspective_camera_is_used_and_others_by_number() {
+    let path = data("cameras/Cameras.gltf");
+    let scene = gltf_scene(&path, None).unwrap();
+    let c = &scene.camera;
+    // Node 1: translation (0.5, 0.5, 3), looking down -z, yfov 0.7 rad, aspect 1.
+    assert!(c.position.distance(Vec3::new(0.5, 0.5, 3.0)) < 1e-6);
+    assert!((c.look_at - c.position).normalize().distance(Vec3::NEG_Z) < 1e-6);
+    assert!((c.fov_y_deg - 0.7f32.to_degrees()).abs() < 1e-4);
+    assert_eq!(c.width, c.height);
+    // The second camera is orthographic: skipped, so there is no camera 1.
+    let err = gltf_scene(&path, Some(1)).unwrap_err().to_string();
+    assert!(err.contains("has no camera 1: it has 1 perspective camera"), "{err}");
+    assert!(gltf_scene(&path, Some(0)).is_ok());
+}
+
+#[test]
+fn strips_fans_and_lists_draw_the_same_square() {
+    for n in ["04", "05", "06", "11", "12"] {
+        let file = format!("Mesh_PrimitiveMode/Mesh_PrimitiveMode_{n}.gltf");
+        let scene = gltf_scene(&data(&file), None).unwrap();
+        let mesh = meshes(&scene)[0];
+        assert_eq!(mesh.indices.len(), 2, "{file}");
+        assert!((area(mesh) - 1.0).abs() < 1e-5, "{file}: area {}", area(mesh));
+        // Counter-clockwise from the front: every triangle faces +z.
+        for t in &mesh.indices {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            assert!((b - a).cross(c - a).z > 0.0, "{file}: {t:?} faces away");
+        }
+    }
+    // Points and lines are skipped, which leaves nothing to render.
+    for n in ["00", "01"] {
+        let file = format!("Mesh_PrimitiveMode/Mesh_PrimitiveMode_{n}.gltf");
+        let err = gltf_scene(&data(&file), None).unwrap_err().to_string();
+        assert!(err.contains("holds no triangles to render"), "{file}: {err}");
+    }
+}
+
+#[test]
+fn every_malformed_sample_is_refused_naming_the_element() {
+    let cases = [
+        ("IndexOutOfRange/IndexOutOfRange.gltf", "mesh 0 primitive 0: index 255 is out of range: the primitive has 24 vertices"),
+        ("IndexOutOfRange/AllIndicesOutOfRange.gltf", "index 65535 is out of range"),
+        ("RecursiveNodes/RecursiveNodes.gltf", "node 0: is its own ancestor"),
+        ("wrongTypes/badArray.gltf", "expected a sequence at line 44"),
+        ("wrongTypes/badExtension.gltf", "expected struct TextureTransform at line 130"),
+        ("wrongTypes/badNumber.gltf", "expected f32 at line 132"),
+        ("wrongTypes/badObject.gltf", "at line 125"),
+        ("wrongTypes/badString.gltf", "expected a string at line 12"),
+        ("wrongTypes/badUint.gltf", "at line 128"),
+        ("BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb", "POSITION\"].min"),
+        ("SchemaFailures/sceneWrongType.gltf", "at line 6"),
+        ("MissingBin/BoxTextured.gltf", "buffer 0: cannot read"),
+        ("TestNoRootNode/NoScene.gltf", "scene: Index out of bounds"),
+        ("TestNoRootNode/SceneWithoutNodes.gltf", "missing field `nodes`"),
+        ("IncorrectVertexArrays/Cube.gltf", "meshes[1].primitives[0]"),
+    ];
+    for (file, expected) in cases {
+        let err = gltf_scene(&data(file), None).unwrap_err().to_string();
+        assert!(err.contains(file), "{file}: the error names the file: {err}");
+        assert!(err.contains(expected), "{file}: {err}");
+    }
+}
+
+/// A glTF file with one triangle (positions only, in a data URI) under `nodes_json`.
+fn triangle_gltf(dir: &Path, nodes_json: &str, positions: &[[f32; 3]; 3]) -> PathBuf {
+    let bytes: Vec<u8> = positions.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let uri = format!(
+        "data:application/octet-stream;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&bytes)
+    );
+    let json = format!(
+        r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}],
+        "nodes": {nodes_json},
+        "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+        "buffers": [{{"byteLength": 36, "uri": "{uri}"}}],
+        "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
+        "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+            "min": [-10, -10, -10], "max": [10, 10, 10]}}]}}"#
+    );
+    let path = dir.join("triangle.gltf");
+    std::fs::write(&path, json).unwrap();
+    path
+}
+
+#[test]
+fn node_transforms_compose_parent_first_and_mirrors_keep_the_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    // Parent: translate (1, 2, 3) and turn 90 degrees about y; child: scale (2, -1, 1)
+    // (a mirror) by matrix, holding the mesh.
+    let (x, y, z, w) = (0.0, std::f32::consts::FRAC_1_SQRT_2, 0.0, std::f32::consts::FRAC_1_SQRT_2);
+    let nodes = format!(
+        r#"[{{"translation": [1, 2, 3], "rotation": [{x}, {y}, {z}, {w}], "children": [1]}},
+           {{"matrix": [2,0,0,0, 0,-1,0,0, 0,0,1,0, 0,0,0,1], "mesh": 0}}]"#
+    );
+    let path = triangle_gltf(dir.path(), &nodes, &corners);
+    let model = load_gltf(&path, Mat4::IDENTITY).unwrap();
+    let Shape::Mesh(mesh) = &model.objects[0].shape else {
+        panic!("a mesh")
+    };
+    let world = Mat4::from_rotation_translation(Quat::from_rotation_y(std::f32::consts::FRAC_PI_2), Vec3::new(1.0, 2.0, 3.0))
+        * Mat4::from_scale(Vec3::new(2.0, -1.0, 1.0));
+    for (i, corner) in corners.iter().enumerate() {
+        let expected = world.transform_point3(Vec3::from(*corner));
+        assert!(mesh.positions[i].distance(expected) < 1e-5, "{} vs {expected}", mesh.positions[i]);
+    }
+    // By hand: (0,1,0) -> scale (0,-1,0) -> turn (0,-1,0) -> move (1,1,3).
+    assert!(mesh.positions[2].distance(Vec3::new(1.0, 1.0, 3.0)) < 1e-5);
+    // The mirror reversed the corners, so the front (counter-clockwise in the file, +z
+    // there) is the image of +z: the turn sends it to +x.
+    let [a, b, c] = mesh.indices[0].map(|i| mesh.positions[i as usize]);
+    let front = (b - a).cross(c - a).normalize();
+    assert!(front.distance(Vec3::X) < 1e-5, "{front}");
+    // No normals in the file: flat shading, as glTF requires.
+    assert!(mesh.flat);
+    // A placement from the scene file applies after the file's own.
+    let moved = load_gltf(&path, Mat4::from_translation(Vec3::Y)).unwrap();
+    let Shape::Mesh(moved) = &moved.objects[0].shape else {
+        panic!("a mesh")
+    };
+    assert!(moved.positions[2].distance(Vec3::new(1.0, 2.0, 3.0)) < 1e-5);
+}
+
+#[test]
+fn bad_hand_made_files_name_the_element() {
+    let dir = tempfile::tempdir().unwrap();
+    let corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [f32::NAN, 1.0, 0.0]];
+    let path = triangle_gltf(dir.path(), r#"[{"mesh": 0}]"#, &corners);
+    let err = load_gltf(&path, Mat4::IDENTITY).unwrap_err().to_string();
+    assert!(err.contains("mesh 0 primitive 0: vertex 2 has position"), "{err}");
+    // A buffer view beyond its buffer.
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace(r#""byteLength": 36}]"#, r#""byteLength": 36, "byteOffset": 12}]"#);
+    std::fs::write(&path, text).unwrap();
+    let err = load_gltf(&path, Mat4::IDENTITY).unwrap_err().to_string();
+    assert!(err.contains("POSITION (accessor 0): buffer view 0 lies outside its buffer"), "{err}");
+    let err = load_gltf(&dir.path().join("absent.glb"), Mat4::IDENTITY).unwrap_err().to_string();
+    assert!(err.contains("absent.glb"), "{err}");
+    std::fs::write(dir.path().join("junk.glb"), b"glTF\x02\x00\x00\x00junk").unwrap();
+    let err = load_gltf(&dir.path().join("junk.glb"), Mat4::IDENTITY).unwrap_err().to_string();
+    assert!(err.contains("junk.glb: not a valid glTF file"), "{err}");
+}
+
+#[test]
+fn texture_transforms_and_samplers_are_read() {
+    let scene = gltf_scene(&data("textureTransform/TextureTransformTest.gltf"), None).unwrap();
+    // The rotation quad: rotation 0.392699 rad about the origin, nothing else.
+    let rotated = scene
+        .materials
+        .iter()
+        .filter_map(|m| m.texture)
+        .find(|t| t.transform[0][1] != 0.0)
+        .expect("a rotated texture");
+    let (s, c) = 0.392_699f32.sin_cos();
+    let expected = [[c, s, 0.0], [-s, c, 0.0]];
+    for (row, want) in rotated.transform.iter().zip(expected) {
+        for (a, b) in row.iter().zip(want) {
+            assert!((a - b).abs() < 1e-6, "{:?} vs {expected:?}", rotated.transform);
+        }
+    }
+    // The file's sampler clamps both axes.
+    assert_eq!(rotated.wrap, [pathlight_scene::Wrap::Clamp; 2]);
+    let pbr = scene.materials[0].metal_rough.expect("a metal-rough material");
+    assert_eq!(pbr.alpha, AlphaMode::Opaque);
+}
+
+#[test]
+fn gltf_entries_mix_with_other_shapes_in_a_scene_file() {
+    let dir = data("BoxTextured-glTF-Binary");
+    let text = r#"
+[camera]
+position = [0, 1, 4]
+look_at = [0, 0, 0]
+fov_y = 40
+resolution = [64, 64]
+
+[materials.floor]
+color = [0.5, 0.5, 0.5]
+
+[materials.shiny]
+metallic = 1.0
+roughness = 0.2
+color = [0.9, 0.7, 0.3]
+
+[[quad]]
+material = "floor"
+origin = [-2, -0.5, 2]
+edge_u = [4, 0, 0]
+edge_v = [0, 0, -4]
+
+[[sphere]]
+material = "shiny"
+center = [1.5, 0, 0]
+radius = 0.5
+
+[[gltf]]
+file = "BoxTextured.glb"
+transform = { translate = [-1, 0, 0], scale = 0.5 }
+"#;
+    let scene = load_scene(&SceneSource {
+        name: "mixed.toml".into(),
+        text,
+        base_dir: dir,
+        embedded: &[],
+    })
+    .unwrap();
+    assert_eq!(scene.objects.len(), 3);
+    assert_eq!(scene.materials.len(), 3);
+    let cube = &scene.objects[2];
+    assert_eq!(cube.material, 2, "the file's material comes after the scene's");
+    let texture = scene.materials[2].texture.unwrap();
+    assert_eq!(texture.texture, 0);
+    let Shape::Mesh(mesh) = &cube.shape else {
+        panic!("a mesh")
+    };
+    let (lo, hi) = mesh
+        .positions
+        .iter()
+        .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    assert!(lo.distance(Vec3::new(-1.25, -0.25, -0.25)) < 1e-5, "{lo}");
+    assert!(hi.distance(Vec3::new(-0.75, 0.25, 0.25)) < 1e-5, "{hi}");
+    let shiny = scene.materials[1].metal_rough.expect("metal-rough from the TOML keys");
+    assert_eq!((shiny.metallic, shiny.roughness), (1.0, 0.2));
+    let bad = text.replace("BoxTextured.glb", "absent.glb");
+    let err = load_scene(&SceneSource {
+        name: "mixed.toml".into(),
+        text: &bad,
+        base_dir: data("BoxTextured-glTF-Binary"),
+        embedded: &[],
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(err.starts_with("mixed.toml:27: gltf.file: cannot read"), "{err}");
+}
