@@ -196,7 +196,9 @@ fn wait_for(file: &str) {
 #[test]
 fn resumed_renders_equal_the_uninterrupted_one() {
     let dir = tempfile::tempdir().unwrap();
-    let spp = "300";
+    // Long enough (about 2 s on 2 cores) that the signal, 0.3 s after the first checkpoint,
+    // always arrives mid-render.
+    let spp = "1200";
     let whole = path(dir.path(), "whole.exr");
     let mut args = RENDER_40.to_vec();
     args.extend(["--spp", spp, "-o", &whole]);

@@ -16,12 +16,12 @@ use pathlight_scene::{Object, Shape, TriangleMesh};
 use rayon::prelude::*;
 
 use crate::bvh;
-use crate::octahedral;
 use crate::error::GeometryError;
 use crate::gpu_types::{
     FLAG_CAPS, FLAG_FLAT, GpuObject, GpuPrimitive, GpuVertex, GpuWideNode, KIND_CYLINDER,
     KIND_MESH, KIND_QUAD, KIND_SPHERE, NO_LIGHT, NO_TRIANGLE,
 };
+use crate::octahedral;
 
 /// The traced form of a scene's objects. It does not depend on materials, lights or the
 /// camera, so it is built once and shared (both backends read it, and a light toggle or a
@@ -193,9 +193,8 @@ impl Geometry {
                             mesh.normals.get(v).copied().unwrap_or_default(),
                         ),
                         uv: mesh.uvs.get(v).copied().unwrap_or_default().to_array(),
-                        tangent: tangent.map_or(octahedral::ZERO, |t| {
-                            octahedral::encode(t.truncate())
-                        }),
+                        tangent: tangent
+                            .map_or(octahedral::ZERO, |t| octahedral::encode(t.truncate())),
                         tangent_sign: tangent.map_or(1.0, |t| if t.w < 0.0 { -1.0 } else { 1.0 }),
                     }
                 })

@@ -8,8 +8,8 @@ use glam::Vec3;
 
 use crate::geometry::Geometry;
 use crate::gpu_types::{
-    FLAG_CAPS, GpuLight, GpuObject, GpuVertex, KIND_CYLINDER, KIND_MESH, KIND_QUAD,
-    KIND_SPHERE, NO_LIGHT,
+    FLAG_CAPS, GpuLight, GpuObject, GpuVertex, KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE,
+    NO_LIGHT,
 };
 
 /// Luminance of linear RGB (Rec. 709 weights): what emitters and environment-map cells are

@@ -4,7 +4,9 @@
 
 use bytemuck::Zeroable;
 use glam::Vec3;
-use pathlight_scene::{AlphaMode, Conductor, Environment, Material, Scene, Texture, TextureRef, Wrap};
+use pathlight_scene::{
+    AlphaMode, Conductor, Environment, Material, Scene, Texture, TextureRef, Wrap,
+};
 
 use crate::environment::texel_scale;
 use crate::geometry::Geometry;

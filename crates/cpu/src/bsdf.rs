@@ -16,9 +16,7 @@
 use std::f32::consts::{FRAC_1_PI, PI};
 
 use glam::{Vec2, Vec3A};
-use pathlight_core::gpu_types::{GpuMaterial, MODEL_METAL_ROUGH};
-
-use crate::metal_rough;
+use pathlight_core::gpu_types::GpuMaterial;
 
 use crate::sampling::{Frame, sample_cosine_hemisphere, sin_cos_turns};
 use crate::surface::Surface;
@@ -177,9 +175,6 @@ fn fresnel_dielectric_local(cos_om: f32, ior: f32) -> f32 {
 /// The continuous part of the BSDF. Twin of WGSL `eval_bsdf`.
 #[inline(always)]
 pub fn eval_bsdf(m: &GpuMaterial, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfEval {
-    if m.model == MODEL_METAL_ROUGH {
-        return metal_rough::eval(m, s, wo, wi);
-    }
     let weights = lobe_weights(m);
     let front = wo.dot(s.ng) >= 0.0;
     let sign = if front { 1.0 } else { -1.0 };
@@ -318,9 +313,6 @@ pub fn sample_bsdf(
     u_fresnel: f32,
     u: Vec2,
 ) -> BsdfSample {
-    if m.model == MODEL_METAL_ROUGH {
-        return metal_rough::sample(m, s, wo, u_lobe, u_fresnel, u);
-    }
     let weights = lobe_weights(m);
     let front = wo.dot(s.ng) >= 0.0;
     let sign = if front { 1.0 } else { -1.0 };
@@ -471,9 +463,6 @@ pub(crate) fn sample_smooth_dielectric(
 /// Twin of WGSL `has_continuous_lobe`.
 #[inline(always)]
 pub fn has_continuous_lobe(m: &GpuMaterial) -> bool {
-    if m.model == MODEL_METAL_ROUGH {
-        return metal_rough::has_continuous_lobe(m);
-    }
     let w = lobe_weights(m);
     w.x > 0.0
         || (w.y > 0.0 && m.specular_roughness * m.specular_roughness >= ALPHA_MIN)

@@ -10,12 +10,12 @@ use pathlight_core::gpu_types::{
 };
 
 use crate::cpu_scene::CpuScene;
-use crate::textures::alpha_stops;
 use crate::intersect::{
     ROBUST_FAR, Ray, ShearedRay, intersect_cylinder, intersect_quad, intersect_sphere,
     intersect_triangle, safe_inverse,
 };
 use crate::packet::Lanes;
+use crate::textures::alpha_stops;
 
 /// The nearest hit of a ray. Twin of WGSL `Hit`.
 #[derive(Debug, Clone, Copy, PartialEq)]

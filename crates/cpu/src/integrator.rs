@@ -4,13 +4,13 @@
 use glam::Vec3A;
 use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams, NO_LIGHT};
 
-use crate::bsdf::{eval_bsdf, has_continuous_lobe, sample_bsdf};
 use crate::bvh::{Hit, Tracer};
 use crate::camera::camera_ray;
 use crate::cpu_scene::CpuScene;
 use crate::environment::env_radiance;
 use crate::intersect::Ray;
 use crate::lights::{LightSample, env_pdf, light_pdf, sample_light};
+use crate::metal_rough::{eval_material, has_continuous_material_lobe, sample_material};
 use crate::sampler::{Draw, Sampler};
 use crate::sampling::power_heuristic;
 use crate::surface::{material_at, surface_at};
@@ -179,13 +179,12 @@ impl Path {
         ]);
         let (u_light_select, u_lobe, u_fresnel, u_rr) =
             (u_light_select.x, u_lobe.x, u_fresnel.x, u_rr.x);
-        let color = Vec3A::from(material.base_color);
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
         let mut shadow = None;
-        if has_continuous_lobe(material) {
+        if has_continuous_material_lobe(material) {
             let ls = sample_light(scene, params, s.position, n, u_light_select, u_light);
             if ls.valid {
-                let e = eval_bsdf(material, color, &s, wo, ls.wi);
+                let e = eval_material(material, &s, wo, ls.wi);
                 if e.f.max_element() > 0.0 {
                     self.sample.rays += 1;
                     let (ray, t_max) = shadow_ray(s.position, s.ng, &ls);
@@ -200,7 +199,7 @@ impl Path {
                 }
             }
         }
-        let bs = sample_bsdf(material, color, &s, wo, u_lobe, u_fresnel, u_bsdf);
+        let bs = sample_material(material, &s, wo, u_lobe, u_fresnel, u_bsdf);
         if !bs.valid {
             self.alive = false;
             return shadow;

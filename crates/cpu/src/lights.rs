@@ -16,13 +16,13 @@ use pathlight_core::gpu_types::{
 use pathlight_core::light_table;
 
 use crate::cpu_scene::CpuScene;
-use crate::surface::material_at;
-use crate::textures::triangle_uv;
 use crate::environment::{env_map_pdf, env_radiance, has_env_map, sample_env_map};
 use crate::intersect::{MISS, Ray, intersect_sphere};
 use crate::sampling::{
     Frame, sample_cosine_hemisphere, sample_disk, sample_uniform_sphere, sin_cos_turns,
 };
+use crate::surface::material_at;
+use crate::textures::triangle_uv;
 
 /// A sampled light direction. Twin of WGSL `LightSample`.
 #[derive(Debug, Clone, Copy)]

@@ -1,4 +1,5 @@
-//! glTF 2.0's metal-rough material. Twin of the metal-rough part of `bsdf.wgsl`.
+//! glTF 2.0's metal-rough material, and the choice between it and the lobe model of
+//! [`crate::bsdf`]. Twin of `metal_rough.wgsl`.
 //!
 //! With base colour `c`, metallic `m`, transmission `t`, roughness `r` (GGX alpha = r^2)
 //! and dielectric Schlick F0 `f0 = ((ior - 1) / (ior + 1))^2`, the BSDF is the sum of
@@ -20,11 +21,12 @@
 use std::f32::consts::FRAC_1_PI;
 
 use glam::{Vec2, Vec3A};
-use pathlight_core::gpu_types::{GpuMaterial, MATERIAL_THIN};
+use pathlight_core::gpu_types::{GpuMaterial, MATERIAL_THIN, MODEL_METAL_ROUGH};
 
 use crate::bsdf::{
-    ALPHA_MIN, BsdfEval, BsdfSample, INVALID, eval_rough_dielectric, fresnel_dielectric,
-    ggx_d, ggx_g1, ggx_sample_visible, rough_dielectric_direction, sample_smooth_dielectric,
+    ALPHA_MIN, BsdfEval, BsdfSample, INVALID, eval_bsdf, eval_rough_dielectric, fresnel_dielectric,
+    ggx_d, ggx_g1, ggx_sample_visible, has_continuous_lobe, rough_dielectric_direction,
+    sample_bsdf, sample_smooth_dielectric,
 };
 use crate::sampling::{Frame, sample_cosine_hemisphere};
 use crate::surface::Surface;
@@ -271,8 +273,39 @@ pub fn sample(
     mixture_sample(m, s, wo, wi)
 }
 
-/// Whether the material has a non-delta lobe. Twin of WGSL `has_continuous_lobe`.
+/// The BSDF of either model. Twin of WGSL `eval_material`.
 #[inline(always)]
-pub fn has_continuous_lobe(m: &GpuMaterial) -> bool {
-    lobes(m).diffuse > 0.0 || m.roughness * m.roughness >= ALPHA_MIN
+pub fn eval_material(m: &GpuMaterial, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfEval {
+    if m.model == MODEL_METAL_ROUGH {
+        eval(m, s, wo, wi)
+    } else {
+        eval_bsdf(m, Vec3A::from(m.base_color), s, wo, wi)
+    }
+}
+
+/// A direction sampled from either model. Twin of WGSL `sample_material`.
+#[inline(always)]
+pub fn sample_material(
+    m: &GpuMaterial,
+    s: &Surface,
+    wo: Vec3A,
+    u_lobe: f32,
+    u_fresnel: f32,
+    u: Vec2,
+) -> BsdfSample {
+    if m.model == MODEL_METAL_ROUGH {
+        sample(m, s, wo, u_lobe, u_fresnel, u)
+    } else {
+        sample_bsdf(m, Vec3A::from(m.base_color), s, wo, u_lobe, u_fresnel, u)
+    }
+}
+
+/// Whether either model has a non-delta lobe. Twin of WGSL `has_continuous_material_lobe`.
+#[inline(always)]
+pub fn has_continuous_material_lobe(m: &GpuMaterial) -> bool {
+    if m.model == MODEL_METAL_ROUGH {
+        lobes(m).diffuse > 0.0 || m.roughness * m.roughness >= ALPHA_MIN
+    } else {
+        has_continuous_lobe(m)
+    }
 }

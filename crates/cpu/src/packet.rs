@@ -20,11 +20,11 @@ use pathlight_core::gpu_types::{
 
 use crate::bvh::{Entry, Hit, RayLanes, Tracer, Walk};
 use crate::cpu_scene::CpuScene;
-use crate::textures::alpha_stops;
 use crate::intersect::{
     MISS, ROBUST_FAR, Ray, ShearedRay, intersect_cylinder, intersect_quad, intersect_sphere,
     intersect_triangle, safe_inverse,
 };
+use crate::textures::alpha_stops;
 
 /// Rays per packet.
 pub const PACKET: usize = 32;

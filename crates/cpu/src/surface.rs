@@ -35,7 +35,11 @@ pub struct Surface {
 pub fn material_at(scene: &CpuScene, material: &GpuMaterial, uv: Vec2) -> GpuMaterial {
     let mut m = *material;
     if m.slots[SLOT_BASE].texture >= 0 {
-        let color = srgb_to_linear(sample_slot(scene, &m.slots[SLOT_BASE], uv).truncate().into());
+        let color = srgb_to_linear(
+            sample_slot(scene, &m.slots[SLOT_BASE], uv)
+                .truncate()
+                .into(),
+        );
         m.base_color = if m.model == MODEL_METAL_ROUGH {
             (Vec3A::from(m.base_color) * color).into()
         } else {
@@ -51,7 +55,11 @@ pub fn material_at(scene: &CpuScene, material: &GpuMaterial, uv: Vec2) -> GpuMat
         m.metallic *= t.z;
     }
     if m.slots[SLOT_EMISSION].texture >= 0 {
-        let t = srgb_to_linear(sample_slot(scene, &m.slots[SLOT_EMISSION], uv).truncate().into());
+        let t = srgb_to_linear(
+            sample_slot(scene, &m.slots[SLOT_EMISSION], uv)
+                .truncate()
+                .into(),
+        );
         m.emission = (Vec3A::from(m.emission) * t).into();
     }
     m
@@ -145,7 +153,8 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
             let [p0, p1, p2] = [v0, v1, v2].map(|v| Vec3A::from(v.position));
             s.ng = (p1 - p0).cross(p2 - p0).normalize();
             let decode = |code: u32| Vec3A::from(octahedral::decode(code));
-            let n = b0 * decode(v0.normal) + hit.b1 * decode(v1.normal) + hit.b2 * decode(v2.normal);
+            let n =
+                b0 * decode(v0.normal) + hit.b1 * decode(v1.normal) + hit.b2 * decode(v2.normal);
             s.uv = b0 * Vec2::from(v0.uv) + hit.b1 * Vec2::from(v1.uv) + hit.b2 * Vec2::from(v2.uv);
             if o.flags & FLAG_FLAT != 0 || n.dot(n) < 1e-12 {
                 s.ns = s.ng;

@@ -3,8 +3,7 @@
 
 use glam::{Vec2, Vec3A, Vec4};
 use pathlight_core::gpu_types::{
-    GpuTextureInfo, GpuTextureSlot, MATERIAL_MASK, SLOT_BASE, WRAP_CLAMP, WRAP_MIRROR,
-    WRAP_REPEAT,
+    GpuTextureInfo, GpuTextureSlot, MATERIAL_MASK, SLOT_BASE, WRAP_CLAMP, WRAP_MIRROR, WRAP_REPEAT,
 };
 
 use crate::cpu_scene::CpuScene;

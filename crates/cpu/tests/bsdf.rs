@@ -9,7 +9,8 @@ use glam::{Vec2, Vec3A};
 use pathlight_core::gpu_types::{
     GpuMaterial, GpuTextureSlot, MATERIAL_THIN, MODEL_LOBES, MODEL_METAL_ROUGH,
 };
-use pathlight_cpu::bsdf::{eval_bsdf, fresnel_conductor, fresnel_dielectric, ggx_d, sample_bsdf};
+use pathlight_cpu::bsdf::{fresnel_conductor, fresnel_dielectric, ggx_d};
+use pathlight_cpu::metal_rough::{eval_material, sample_material};
 use pathlight_cpu::sampling::sample_uniform_sphere;
 use pathlight_cpu::surface::Surface;
 use rand::rngs::StdRng;
@@ -56,7 +57,13 @@ fn material(
 
 /// glTF's metal-rough model: base colour, metallic, roughness, transmission (thin wall or
 /// solid).
-fn metal_rough(color: [f32; 3], metallic: f32, roughness: f32, transmission: f32, thin: bool) -> GpuMaterial {
+fn metal_rough(
+    color: [f32; 3],
+    metallic: f32,
+    roughness: f32,
+    transmission: f32,
+    thin: bool,
+) -> GpuMaterial {
     GpuMaterial {
         base_color: color,
         model: MODEL_METAL_ROUGH,
@@ -86,15 +93,42 @@ fn cases() -> Vec<(&'static str, GpuMaterial)> {
             "rough glass over diffuse",
             material(0.0, 0.0, 0.6, 0.3, false),
         ),
-        ("metal-rough white dielectric, rough", metal_rough([1.0; 3], 0.0, 1.0, 0.0, true)),
-        ("metal-rough white dielectric, glossy", metal_rough([1.0; 3], 0.0, 0.3, 0.0, true)),
-        ("metal-rough smooth dielectric", metal_rough([1.0; 3], 0.0, 0.0, 0.0, true)),
-        ("metal-rough coloured metal", metal_rough([0.9, 0.6, 0.2], 1.0, 0.5, 0.0, true)),
-        ("metal-rough half metal", metal_rough([0.5, 0.8, 1.0], 0.5, 0.2, 0.0, true)),
-        ("metal-rough thin rough wall", metal_rough([1.0; 3], 0.0, 0.4, 1.0, true)),
-        ("metal-rough thin smooth wall", metal_rough([0.8, 1.0, 0.9], 0.0, 0.0, 0.7, true)),
-        ("metal-rough solid rough glass", metal_rough([1.0; 3], 0.0, 0.5, 1.0, false)),
-        ("metal-rough solid smooth glass", metal_rough([1.0; 3], 0.0, 0.0, 0.6, false)),
+        (
+            "metal-rough white dielectric, rough",
+            metal_rough([1.0; 3], 0.0, 1.0, 0.0, true),
+        ),
+        (
+            "metal-rough white dielectric, glossy",
+            metal_rough([1.0; 3], 0.0, 0.3, 0.0, true),
+        ),
+        (
+            "metal-rough smooth dielectric",
+            metal_rough([1.0; 3], 0.0, 0.0, 0.0, true),
+        ),
+        (
+            "metal-rough coloured metal",
+            metal_rough([0.9, 0.6, 0.2], 1.0, 0.5, 0.0, true),
+        ),
+        (
+            "metal-rough half metal",
+            metal_rough([0.5, 0.8, 1.0], 0.5, 0.2, 0.0, true),
+        ),
+        (
+            "metal-rough thin rough wall",
+            metal_rough([1.0; 3], 0.0, 0.4, 1.0, true),
+        ),
+        (
+            "metal-rough thin smooth wall",
+            metal_rough([0.8, 1.0, 0.9], 0.0, 0.0, 0.7, true),
+        ),
+        (
+            "metal-rough solid rough glass",
+            metal_rough([1.0; 3], 0.0, 0.5, 1.0, false),
+        ),
+        (
+            "metal-rough solid smooth glass",
+            metal_rough([1.0; 3], 0.0, 0.0, 0.6, false),
+        ),
     ]
 }
 
@@ -131,7 +165,7 @@ fn outgoing() -> Vec<Vec3A> {
 
 fn sample(rng: &mut StdRng, m: &GpuMaterial, wo: Vec3A) -> pathlight_cpu::bsdf::BsdfSample {
     let u = Vec2::new(rng.random(), rng.random());
-    sample_bsdf(m, Vec3A::ONE, &surface(), wo, rng.random(), rng.random(), u)
+    sample_material(m, &surface(), wo, rng.random(), rng.random(), u)
 }
 
 #[test]
@@ -144,7 +178,7 @@ fn samples_agree_with_eval_and_pdf() {
                 if !bs.valid || bs.delta {
                     continue;
                 }
-                let e = eval_bsdf(&m, Vec3A::ONE, &surface(), wo, bs.wi);
+                let e = eval_material(&m, &surface(), wo, bs.wi);
                 assert!(
                     (bs.pdf - e.pdf).abs() <= 1e-3 * e.pdf,
                     "{name}: pdf {} vs eval {}",
@@ -171,9 +205,7 @@ fn densities_integrate_to_the_non_delta_probability() {
             let integrals: Vec<f64> = (0..N)
                 .map(|_| {
                     let wi = sample_uniform_sphere(Vec2::new(rng.random(), rng.random()));
-                    f64::from(eval_bsdf(&m, Vec3A::ONE, &surface(), wo, wi).pdf)
-                        * 4.0
-                        * f64::from(PI)
+                    f64::from(eval_material(&m, &surface(), wo, wi).pdf) * 4.0 * f64::from(PI)
                 })
                 .collect();
             let (mean, error) = mean_and_error(&integrals);
@@ -218,7 +250,7 @@ fn sampled_albedo_equals_the_integral_of_eval() {
             let integrated: Vec<f64> = (0..4 * N)
                 .map(|_| {
                     let wi = sample_uniform_sphere(Vec2::new(rng.random(), rng.random()));
-                    let f = eval_bsdf(&m, Vec3A::ONE, &surface(), wo, wi).f.x;
+                    let f = eval_material(&m, &surface(), wo, wi).f.x;
                     f64::from(f) * 4.0 * f64::from(PI)
                 })
                 .collect();
@@ -250,12 +282,10 @@ fn no_material_creates_energy() {
             let (mean, error) = mean_and_error(&weights);
             // Refraction scales radiance by 1/eta^2 going in and eta^2 coming out.
             let solid = m.refract_rate > 0.0
-                || (m.model == MODEL_METAL_ROUGH && m.transmission > 0.0 && m.flags & MATERIAL_THIN == 0);
-            let bound = if wo.z < 0.0 && solid {
-                2.25
-            } else {
-                1.0
-            };
+                || (m.model == MODEL_METAL_ROUGH
+                    && m.transmission > 0.0
+                    && m.flags & MATERIAL_THIN == 0);
+            let bound = if wo.z < 0.0 && solid { 2.25 } else { 1.0 };
             assert!(
                 mean <= bound + 5.0 * error + 1e-4,
                 "{name}, wo {wo}: albedo {mean}"
@@ -360,7 +390,7 @@ fn metallic_one_is_a_schlick_conductor() {
     };
     let schlick = f0 + (Vec3A::ONE - f0) * (1.0 - wo.dot(h)).powi(5);
     let expected = ggx_d(h, alpha) * g1(wo) * g1(wi) * schlick / (4.0 * wo.z);
-    let e = eval_bsdf(&m, f0, &surface(), wo, wi);
+    let e = eval_material(&m, &surface(), wo, wi);
     assert!(
         (e.f - expected).abs().max_element() < 1e-5,
         "{} vs {expected}",
@@ -371,5 +401,9 @@ fn metallic_one_is_a_schlick_conductor() {
     let bs = sample(&mut rng, &smooth, wo);
     assert!(bs.delta && bs.valid);
     let reflected = f0 + (Vec3A::ONE - f0) * (1.0 - wo.z).powi(5);
-    assert!((bs.weight - reflected).abs().max_element() < 1e-5, "{}", bs.weight);
+    assert!(
+        (bs.weight - reflected).abs().max_element() < 1e-5,
+        "{}",
+        bs.weight
+    );
 }

@@ -13,6 +13,7 @@
 #import camera
 #import surface
 #import bsdf
+#import metal_rough
 #import lights
 
 // Running sum of samples per channel as a 64-bit fixed-point number hi + lo / 2^32.
@@ -160,12 +161,11 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
         let u_fresnel = next_1d(sampler);
         let u_bsdf = next_2d(sampler);
         let u_rr = next_1d(sampler);
-        let color = material.base_color;
         let n = select(-s.ns, s.ns, dot(wo, s.ng) >= 0.0);
-        if has_continuous_lobe(material) {
+        if has_continuous_material_lobe(material) {
             let ls = sample_light(s.position, n, u_light_select, u_light);
             if ls.valid {
-                let e = eval_bsdf(material, color, s, wo, ls.wi);
+                let e = eval_material(material, s, wo, ls.wi);
                 if max(max(e.f.x, e.f.y), e.f.z) > 0.0 {
                     shadow = shadow_ray(s.position, s.ng, ls);
                     shadow_radiance = throughput * e.f * ls.radiance * power_heuristic(ls.pdf, e.pdf) / ls.pdf;
@@ -173,7 +173,7 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
                 }
             }
         }
-        let bs = sample_bsdf(material, color, s, wo, u_lobe, u_fresnel, u_bsdf);
+        let bs = sample_material(material, s, wo, u_lobe, u_fresnel, u_bsdf);
         if bs.valid {
             throughput *= bs.weight;
             prev_pdf = bs.pdf;

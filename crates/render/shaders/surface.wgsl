@@ -19,7 +19,7 @@ struct Surface {
 }
 
 // The unit vector of an octahedral code; zero for the code 0x80008000.
-// CPU twin: `pathlight_core::octahedral::decode`.
+// Host twin (encoder and decoder): `pathlight_core::octahedral`.
 fn decode_unit(code: u32) -> vec3f {
     if code == 0x80008000u {
         return vec3f(0.0);

@@ -13,7 +13,7 @@
 use std::fmt::Write as _;
 
 /// Every WGSL file of the crate, by the name imports use.
-pub const FILES: [(&str, &str); 14] = [
+pub const FILES: [(&str, &str); 15] = [
     ("scene", include_str!("../shaders/scene.wgsl")),
     ("textures", include_str!("../shaders/textures.wgsl")),
     ("intersect", include_str!("../shaders/intersect.wgsl")),
@@ -24,6 +24,7 @@ pub const FILES: [(&str, &str); 14] = [
     ("camera", include_str!("../shaders/camera.wgsl")),
     ("surface", include_str!("../shaders/surface.wgsl")),
     ("bsdf", include_str!("../shaders/bsdf.wgsl")),
+    ("metal_rough", include_str!("../shaders/metal_rough.wgsl")),
     ("environment", include_str!("../shaders/environment.wgsl")),
     ("lights", include_str!("../shaders/lights.wgsl")),
     ("integrator", include_str!("../shaders/integrator.wgsl")),

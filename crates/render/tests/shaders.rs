@@ -8,7 +8,7 @@ use std::mem::{offset_of, size_of};
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use pathlight_core::gpu_types::{
     GpuAccumPixel, GpuCamera, GpuLight, GpuMaterial, GpuObject, GpuPrimitive, GpuRenderParams,
-    GpuTextureInfo, GpuVertex, GpuWideNode,
+    GpuTextureInfo, GpuTextureSlot, GpuVertex, GpuWideNode,
 };
 use pathlight_render::display::GpuDisplayParams;
 use pathlight_render::wgsl::{self, AssemblyError};
@@ -127,7 +127,13 @@ fn host_structs_match_their_wgsl_declarations() {
         GpuWideNode,
         [lo_x, lo_y, lo_z, hi_x, hi_y, hi_z, first, count]
     );
-    assert_layout!(m, "Vertex", GpuVertex, [position, u, normal, v]);
+    assert_layout!(
+        m,
+        "Vertex",
+        GpuVertex,
+        [position, normal, uv, tangent, tangent_sign]
+    );
+    assert_layout!(m, "TextureSlot", GpuTextureSlot, [u, texture, v, wrap]);
     assert_layout!(
         m,
         "Primitive",
@@ -140,7 +146,7 @@ fn host_structs_match_their_wgsl_declarations() {
         GpuMaterial,
         [
             base_color,
-            texture,
+            model,
             emission,
             specular_rate,
             eta,
@@ -151,7 +157,15 @@ fn host_structs_match_their_wgsl_declarations() {
             refract_tint,
             ior,
             refract_roughness,
-            conductor
+            conductor,
+            metallic,
+            roughness,
+            transmission,
+            normal_scale,
+            alpha_cutoff,
+            alpha_factor,
+            flags,
+            slots
         ]
     );
     assert_layout!(m, "TextureInfo", GpuTextureInfo, [offset, width, height]);

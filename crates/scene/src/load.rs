@@ -12,8 +12,8 @@ use crate::desc::{
     ColorSpace, EnvironmentDesc, GltfDesc, MaterialDesc, RenderDesc, SamplerDesc, SceneDesc,
     Shading,
 };
-use crate::gltf_file::load_gltf;
 use crate::error::SceneError;
+use crate::gltf_file::load_gltf;
 use crate::revolve::Revolution;
 use crate::settings::{MAX_COORDINATE, check_max_depth, check_resolution, check_spp};
 use crate::texture::srgb_to_linear;
@@ -450,7 +450,10 @@ impl Builder<'_, '_> {
             ("refract_rate", m.refract_rate.is_some()),
             ("refract_tint", m.refract_tint.is_some()),
             ("refract_roughness", m.refract_roughness.is_some()),
-            ("conductor", m.conductor.is_some() || m.eta.is_some() || m.k.is_some()),
+            (
+                "conductor",
+                m.conductor.is_some() || m.eta.is_some() || m.k.is_some(),
+            ),
         ];
         if let Some((lobe_key, _)) = lobe_keys.iter().find(|(_, given)| *given) {
             return Err(self.invalid(
@@ -482,8 +485,16 @@ impl Builder<'_, '_> {
             conductor: None,
             metal_rough: Some(MetalRough {
                 metallic: self.unit(span.clone(), &key("metallic"), m.metallic.unwrap_or(0.0))?,
-                roughness: self.unit(span.clone(), &key("roughness"), m.roughness.unwrap_or(1.0))?,
-                transmission: self.unit(span, &key("transmission"), m.transmission.unwrap_or(0.0))?,
+                roughness: self.unit(
+                    span.clone(),
+                    &key("roughness"),
+                    m.roughness.unwrap_or(1.0),
+                )?,
+                transmission: self.unit(
+                    span,
+                    &key("transmission"),
+                    m.transmission.unwrap_or(0.0),
+                )?,
                 ior,
                 ..MetalRough::DEFAULT
             }),

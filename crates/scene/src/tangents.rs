@@ -109,16 +109,16 @@ mod tests {
                 tri.map(|v| mesh.positions[v as usize]),
                 tri.map(|v| mesh.uvs[v as usize]),
             );
-            assert!(t.truncate().distance(expected) < 1e-5, "corner {i}: {t} vs {expected}");
+            assert!(
+                t.truncate().distance(expected) < 1e-5,
+                "corner {i}: {t} vs {expected}"
+            );
             // d(position)/dv = -(s, c, 0) = -cross(z, tangent): w = -1.
             assert_eq!(t.w, -1.0, "corner {i}");
         }
         // The hand-computed tangent itself: d(position)/du = (c, -s, 0).
         assert!(
-            tangents[0]
-                .truncate()
-                .distance(Vec3::new(c, -s, 0.0))
-                < 1e-5,
+            tangents[0].truncate().distance(Vec3::new(c, -s, 0.0)) < 1e-5,
             "{}",
             tangents[0]
         );

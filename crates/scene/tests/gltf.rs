@@ -13,7 +13,9 @@ use pathlight_scene::{
 };
 
 fn data(path: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/gltf").join(path)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/gltf")
+        .join(path)
 }
 
 fn meshes(scene: &Scene) -> Vec<&TriangleMesh> {
@@ -67,7 +69,10 @@ fn a_model_without_cameras_is_framed_from_the_front() {
     assert!(c.look_at.length() < 1e-5, "{}", c.look_at);
     let distance = c.position.length();
     let expected = 0.75f32.sqrt() / 20f32.to_radians().sin();
-    assert!((distance - expected).abs() < 1e-4, "{distance} vs {expected}");
+    assert!(
+        (distance - expected).abs() < 1e-4,
+        "{distance} vs {expected}"
+    );
     assert!(c.position.z > 0.0 && c.position.y > 0.0);
     assert_eq!((c.width, c.height), (1280, 720));
 }
@@ -84,7 +89,10 @@ fn the_first_perspective_camera_is_used_and_others_by_number() {
     assert_eq!(c.width, c.height);
     // The second camera is orthographic: skipped, so there is no camera 1.
     let err = gltf_scene(&path, Some(1)).unwrap_err().to_string();
-    assert!(err.contains("has no camera 1: it has 1 perspective camera"), "{err}");
+    assert!(
+        err.contains("has no camera 1: it has 1 perspective camera"),
+        "{err}"
+    );
     assert!(gltf_scene(&path, Some(0)).is_ok());
 }
 
@@ -95,7 +103,11 @@ fn strips_fans_and_lists_draw_the_same_square() {
         let scene = gltf_scene(&data(&file), None).unwrap();
         let mesh = meshes(&scene)[0];
         assert_eq!(mesh.indices.len(), 2, "{file}");
-        assert!((area(mesh) - 1.0).abs() < 1e-5, "{file}: area {}", area(mesh));
+        assert!(
+            (area(mesh) - 1.0).abs() < 1e-5,
+            "{file}: area {}",
+            area(mesh)
+        );
         // Counter-clockwise from the front: every triangle faces +z.
         for t in &mesh.indices {
             let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
@@ -106,39 +118,67 @@ fn strips_fans_and_lists_draw_the_same_square() {
     for n in ["00", "01"] {
         let file = format!("Mesh_PrimitiveMode/Mesh_PrimitiveMode_{n}.gltf");
         let err = gltf_scene(&data(&file), None).unwrap_err().to_string();
-        assert!(err.contains("holds no triangles to render"), "{file}: {err}");
+        assert!(
+            err.contains("holds no triangles to render"),
+            "{file}: {err}"
+        );
     }
 }
 
 #[test]
 fn every_malformed_sample_is_refused_naming_the_element() {
     let cases = [
-        ("IndexOutOfRange/IndexOutOfRange.gltf", "mesh 0 primitive 0: index 255 is out of range: the primitive has 24 vertices"),
-        ("IndexOutOfRange/AllIndicesOutOfRange.gltf", "index 65535 is out of range"),
-        ("RecursiveNodes/RecursiveNodes.gltf", "node 0: is its own ancestor"),
+        (
+            "IndexOutOfRange/IndexOutOfRange.gltf",
+            "mesh 0 primitive 0: index 255 is out of range: the primitive has 24 vertices",
+        ),
+        (
+            "IndexOutOfRange/AllIndicesOutOfRange.gltf",
+            "index 65535 is out of range",
+        ),
+        (
+            "RecursiveNodes/RecursiveNodes.gltf",
+            "node 0: is its own ancestor",
+        ),
         ("wrongTypes/badArray.gltf", "expected a sequence at line 44"),
-        ("wrongTypes/badExtension.gltf", "expected struct TextureTransform at line 130"),
+        (
+            "wrongTypes/badExtension.gltf",
+            "expected struct TextureTransform at line 130",
+        ),
         ("wrongTypes/badNumber.gltf", "expected f32 at line 132"),
         ("wrongTypes/badObject.gltf", "at line 125"),
         ("wrongTypes/badString.gltf", "expected a string at line 12"),
         ("wrongTypes/badUint.gltf", "at line 128"),
-        ("BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb", "POSITION\"].min"),
+        (
+            "BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb",
+            "POSITION\"].min",
+        ),
         ("SchemaFailures/sceneWrongType.gltf", "at line 6"),
         ("MissingBin/BoxTextured.gltf", "buffer 0: cannot read"),
         ("TestNoRootNode/NoScene.gltf", "scene: Index out of bounds"),
-        ("TestNoRootNode/SceneWithoutNodes.gltf", "missing field `nodes`"),
+        (
+            "TestNoRootNode/SceneWithoutNodes.gltf",
+            "missing field `nodes`",
+        ),
         ("IncorrectVertexArrays/Cube.gltf", "meshes[1].primitives[0]"),
     ];
     for (file, expected) in cases {
         let err = gltf_scene(&data(file), None).unwrap_err().to_string();
-        assert!(err.contains(file), "{file}: the error names the file: {err}");
+        assert!(
+            err.contains(file),
+            "{file}: the error names the file: {err}"
+        );
         assert!(err.contains(expected), "{file}: {err}");
     }
 }
 
 /// A glTF file with one triangle (positions only, in a data URI) under `nodes_json`.
 fn triangle_gltf(dir: &Path, nodes_json: &str, positions: &[[f32; 3]; 3]) -> PathBuf {
-    let bytes: Vec<u8> = positions.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let bytes: Vec<u8> = positions
+        .iter()
+        .flatten()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
     let uri = format!(
         "data:application/octet-stream;base64,{}",
         base64::engine::general_purpose::STANDARD.encode(&bytes)
@@ -163,7 +203,12 @@ fn node_transforms_compose_parent_first_and_mirrors_keep_the_front() {
     let corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
     // Parent: translate (1, 2, 3) and turn 90 degrees about y; child: scale (2, -1, 1)
     // (a mirror) by matrix, holding the mesh.
-    let (x, y, z, w) = (0.0, std::f32::consts::FRAC_1_SQRT_2, 0.0, std::f32::consts::FRAC_1_SQRT_2);
+    let (x, y, z, w) = (
+        0.0,
+        std::f32::consts::FRAC_1_SQRT_2,
+        0.0,
+        std::f32::consts::FRAC_1_SQRT_2,
+    );
     let nodes = format!(
         r#"[{{"translation": [1, 2, 3], "rotation": [{x}, {y}, {z}, {w}], "children": [1]}},
            {{"matrix": [2,0,0,0, 0,-1,0,0, 0,0,1,0, 0,0,0,1], "mesh": 0}}]"#
@@ -173,11 +218,17 @@ fn node_transforms_compose_parent_first_and_mirrors_keep_the_front() {
     let Shape::Mesh(mesh) = &model.objects[0].shape else {
         panic!("a mesh")
     };
-    let world = Mat4::from_rotation_translation(Quat::from_rotation_y(std::f32::consts::FRAC_PI_2), Vec3::new(1.0, 2.0, 3.0))
-        * Mat4::from_scale(Vec3::new(2.0, -1.0, 1.0));
+    let world = Mat4::from_rotation_translation(
+        Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+        Vec3::new(1.0, 2.0, 3.0),
+    ) * Mat4::from_scale(Vec3::new(2.0, -1.0, 1.0));
     for (i, corner) in corners.iter().enumerate() {
         let expected = world.transform_point3(Vec3::from(*corner));
-        assert!(mesh.positions[i].distance(expected) < 1e-5, "{} vs {expected}", mesh.positions[i]);
+        assert!(
+            mesh.positions[i].distance(expected) < 1e-5,
+            "{} vs {expected}",
+            mesh.positions[i]
+        );
     }
     // By hand: (0,1,0) -> scale (0,-1,0) -> turn (0,-1,0) -> move (1,1,3).
     assert!(mesh.positions[2].distance(Vec3::new(1.0, 1.0, 3.0)) < 1e-5);
@@ -202,18 +253,29 @@ fn bad_hand_made_files_name_the_element() {
     let corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [f32::NAN, 1.0, 0.0]];
     let path = triangle_gltf(dir.path(), r#"[{"mesh": 0}]"#, &corners);
     let err = load_gltf(&path, Mat4::IDENTITY).unwrap_err().to_string();
-    assert!(err.contains("mesh 0 primitive 0: vertex 2 has position"), "{err}");
+    assert!(
+        err.contains("mesh 0 primitive 0: vertex 2 has position"),
+        "{err}"
+    );
     // A buffer view beyond its buffer.
-    let text = std::fs::read_to_string(&path)
-        .unwrap()
-        .replace(r#""byteLength": 36}]"#, r#""byteLength": 36, "byteOffset": 12}]"#);
+    let text = std::fs::read_to_string(&path).unwrap().replace(
+        r#""byteLength": 36}]"#,
+        r#""byteLength": 36, "byteOffset": 12}]"#,
+    );
     std::fs::write(&path, text).unwrap();
     let err = load_gltf(&path, Mat4::IDENTITY).unwrap_err().to_string();
-    assert!(err.contains("POSITION (accessor 0): buffer view 0 lies outside its buffer"), "{err}");
-    let err = load_gltf(&dir.path().join("absent.glb"), Mat4::IDENTITY).unwrap_err().to_string();
+    assert!(
+        err.contains("POSITION (accessor 0): buffer view 0 lies outside its buffer"),
+        "{err}"
+    );
+    let err = load_gltf(&dir.path().join("absent.glb"), Mat4::IDENTITY)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("absent.glb"), "{err}");
     std::fs::write(dir.path().join("junk.glb"), b"glTF\x02\x00\x00\x00junk").unwrap();
-    let err = load_gltf(&dir.path().join("junk.glb"), Mat4::IDENTITY).unwrap_err().to_string();
+    let err = load_gltf(&dir.path().join("junk.glb"), Mat4::IDENTITY)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("junk.glb: not a valid glTF file"), "{err}");
 }
 
@@ -231,12 +293,18 @@ fn texture_transforms_and_samplers_are_read() {
     let expected = [[c, s, 0.0], [-s, c, 0.0]];
     for (row, want) in rotated.transform.iter().zip(expected) {
         for (a, b) in row.iter().zip(want) {
-            assert!((a - b).abs() < 1e-6, "{:?} vs {expected:?}", rotated.transform);
+            assert!(
+                (a - b).abs() < 1e-6,
+                "{:?} vs {expected:?}",
+                rotated.transform
+            );
         }
     }
     // The file's sampler clamps both axes.
     assert_eq!(rotated.wrap, [pathlight_scene::Wrap::Clamp; 2]);
-    let pbr = scene.materials[0].metal_rough.expect("a metal-rough material");
+    let pbr = scene.materials[0]
+        .metal_rough
+        .expect("a metal-rough material");
     assert_eq!(pbr.alpha, AlphaMode::Opaque);
 }
 
@@ -283,7 +351,10 @@ transform = { translate = [-1, 0, 0], scale = 0.5 }
     assert_eq!(scene.objects.len(), 3);
     assert_eq!(scene.materials.len(), 3);
     let cube = &scene.objects[2];
-    assert_eq!(cube.material, 2, "the file's material comes after the scene's");
+    assert_eq!(
+        cube.material, 2,
+        "the file's material comes after the scene's"
+    );
     let texture = scene.materials[2].texture.unwrap();
     assert_eq!(texture.texture, 0);
     let Shape::Mesh(mesh) = &cube.shape else {
@@ -292,10 +363,14 @@ transform = { translate = [-1, 0, 0], scale = 0.5 }
     let (lo, hi) = mesh
         .positions
         .iter()
-        .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
     assert!(lo.distance(Vec3::new(-1.25, -0.25, -0.25)) < 1e-5, "{lo}");
     assert!(hi.distance(Vec3::new(-0.75, 0.25, 0.25)) < 1e-5, "{hi}");
-    let shiny = scene.materials[1].metal_rough.expect("metal-rough from the TOML keys");
+    let shiny = scene.materials[1]
+        .metal_rough
+        .expect("metal-rough from the TOML keys");
     assert_eq!((shiny.metallic, shiny.roughness), (1.0, 0.2));
     let bad = text.replace("BoxTextured.glb", "absent.glb");
     let err = load_scene(&SceneSource {
@@ -306,5 +381,8 @@ transform = { translate = [-1, 0, 0], scale = 0.5 }
     })
     .unwrap_err()
     .to_string();
-    assert!(err.starts_with("mixed.toml:27: gltf.file: cannot read"), "{err}");
+    assert!(
+        err.starts_with("mixed.toml:27: gltf.file: cannot read"),
+        "{err}"
+    );
 }

@@ -4,6 +4,7 @@ mod common;
 mod display;
 mod extreme;
 mod furnace;
+mod metal_rough;
 mod render;
 mod state;
 mod trace;

@@ -36,16 +36,17 @@ impl Files<'_> {
             }
             return base64::engine::general_purpose::STANDARD
                 .decode(payload)
-                .map_err(|err| self.error(element, format!("data URI is not valid base64: {err}")));
+                .map_err(|err| {
+                    self.error(element, format!("data URI is not valid base64: {err}"))
+                });
         }
         if uri.contains("://") {
             return Err(self.error(element, format!("URI {uri:?} is not a local file")));
         }
         let decoded = percent_encoding::percent_decode_str(uri).decode_utf8_lossy();
         let file = self.base.join(decoded.as_ref());
-        std::fs::read(&file).map_err(|err| {
-            self.error(element, format!("cannot read {}: {err}", file.display()))
-        })
+        std::fs::read(&file)
+            .map_err(|err| self.error(element, format!("cannot read {}: {err}", file.display())))
     }
 
     /// Every buffer's bytes, each at least as long as the file says.
@@ -60,15 +61,19 @@ impl Files<'_> {
             .map(|buffer| {
                 let element = format!("buffer {}", buffer.index());
                 let bytes = match buffer.source() {
-                    gltf::buffer::Source::Bin => blob
-                        .take()
-                        .ok_or_else(|| self.error(&element, "refers to a GLB binary chunk the file lacks"))?,
+                    gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
+                        self.error(&element, "refers to a GLB binary chunk the file lacks")
+                    })?,
                     gltf::buffer::Source::Uri(uri) => self.uri_bytes(&element, uri)?,
                 };
                 if bytes.len() < buffer.length() {
                     return Err(self.error(
                         &element,
-                        format!("holds {} bytes; the file says {}", bytes.len(), buffer.length()),
+                        format!(
+                            "holds {} bytes; the file says {}",
+                            bytes.len(),
+                            buffer.length()
+                        ),
                     ));
                 }
                 Ok(bytes)
@@ -86,8 +91,12 @@ impl Files<'_> {
         match image.source() {
             gltf::image::Source::Uri { uri, .. } => self.uri_bytes(&element, uri),
             gltf::image::Source::View { view, .. } => {
-                let range = view_range(&view, buffers)
-                    .ok_or_else(|| self.error(&element, format!("buffer view {} lies outside its buffer", view.index())))?;
+                let range = view_range(&view, buffers).ok_or_else(|| {
+                    self.error(
+                        &element,
+                        format!("buffer view {} lies outside its buffer", view.index()),
+                    )
+                })?;
                 Ok(buffers[view.buffer().index()][range].to_vec())
             }
         }

@@ -48,7 +48,8 @@ impl Materials {
         let converted = self.convert(files, buffers, material)?;
         let index = self.materials.len() as u32;
         self.materials.push(converted.0);
-        self.converted.insert(material.index(), (index, converted.1));
+        self.converted
+            .insert(material.index(), (index, converted.1));
         Ok((index, converted.1))
     }
 
@@ -65,24 +66,23 @@ impl Materials {
         let pbr = material.pbr_metallic_roughness();
         let [r, g, b, alpha_factor] = pbr.base_color_factor();
         let mut uv_sets = Vec::new();
-        let mut reference =
-            |this: &mut Self, info: Option<TextureUse>| {
-                info.map(|(texture, tex_coord, transform)| {
-                    let set = transform.as_ref().and_then(|t| t.tex_coord()).unwrap_or(tex_coord);
-                    uv_sets.push(set);
-                    this.texture_ref(files, buffers, &texture, transform.as_ref())
-                })
-                .transpose()
-            };
+        let mut reference = |this: &mut Self, info: Option<TextureUse>| {
+            info.map(|(texture, tex_coord, transform)| {
+                let set = transform
+                    .as_ref()
+                    .and_then(|t| t.tex_coord())
+                    .unwrap_or(tex_coord);
+                uv_sets.push(set);
+                this.texture_ref(files, buffers, &texture, transform.as_ref())
+            })
+            .transpose()
+        };
         let base_texture = reference(self, pbr.base_color_texture().map(info))?;
         let metal_rough_texture = reference(self, pbr.metallic_roughness_texture().map(info))?;
         let emission_texture = reference(self, material.emissive_texture().map(info))?;
         let normal = material.normal_texture();
         let normal_scale = normal.as_ref().map_or(1.0, |n| n.scale());
-        let normal_texture = reference(
-            self,
-            normal.map(|n| (n.texture(), n.tex_coord(), None)),
-        )?;
+        let normal_texture = reference(self, normal.map(|n| (n.texture(), n.tex_coord(), None)))?;
         let uv_set = uv_sets.first().copied().unwrap_or(0);
         if uv_sets.iter().any(|&s| s != uv_set) {
             log::warn!(
@@ -93,7 +93,10 @@ impl Materials {
         let strength = material.emissive_strength().unwrap_or(1.0);
         let emission = Vec3::from(material.emissive_factor()) * strength;
         let transmission = material.transmission();
-        if transmission.as_ref().is_some_and(|t| t.transmission_texture().is_some()) {
+        if transmission
+            .as_ref()
+            .is_some_and(|t| t.transmission_texture().is_some())
+        {
             log::warn!(
                 "{}: {element}: the transmission texture is ignored (its factor is used)",
                 files.path.display()
@@ -102,7 +105,9 @@ impl Materials {
         let thickness = material.volume().map_or(0.0, |v| v.thickness_factor());
         let alpha = match material.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
-            gltf::material::AlphaMode::Mask => AlphaMode::Mask(material.alpha_cutoff().unwrap_or(0.5)),
+            gltf::material::AlphaMode::Mask => {
+                AlphaMode::Mask(material.alpha_cutoff().unwrap_or(0.5))
+            }
             gltf::material::AlphaMode::Blend => AlphaMode::Blend,
         };
         let metal_rough = MetalRough {
@@ -133,14 +138,19 @@ impl Materials {
             emission.z,
         ];
         if numbers.iter().any(|v| !v.is_finite() || *v < 0.0) || metal_rough.ior < 1.0 {
-            return Err(files.error(&element, format!("a factor is negative or not finite: {numbers:?}")));
+            return Err(files.error(
+                &element,
+                format!("a factor is negative or not finite: {numbers:?}"),
+            ));
         }
         let needs = Needs {
             uv_set,
             tangents: normal_texture.is_some(),
         };
         let material = Material {
-            name: material.name().map_or_else(|| element.clone(), str::to_owned),
+            name: material
+                .name()
+                .map_or_else(|| element.clone(), str::to_owned),
             base_color: Vec3::new(r, g, b).min(Vec3::ONE),
             texture: base_texture,
             emission,
@@ -170,9 +180,11 @@ impl Materials {
             Some(&i) => i,
             None => {
                 let bytes = files.image_bytes(&image, buffers)?;
-                let name = files
-                    .path
-                    .with_file_name(format!("{}#image{}", file_name(files), image.index()));
+                let name = files.path.with_file_name(format!(
+                    "{}#image{}",
+                    file_name(files),
+                    image.index()
+                ));
                 let decoded = Texture::decode(&bytes, &name)?;
                 let i = self.textures.len() as u32;
                 self.textures.push(decoded);

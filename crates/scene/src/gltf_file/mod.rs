@@ -65,12 +65,16 @@ impl GltfModel {
                 _ => None,
             })
             .flatten()
-            .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+            .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| {
+                (lo.min(p), hi.max(p))
+            })
     }
 
     /// Whether any material emits.
     pub fn has_emitters(&self) -> bool {
-        self.materials.iter().any(|m| m.emission.max_element() > 0.0)
+        self.materials
+            .iter()
+            .any(|m| m.emission.max_element() > 0.0)
     }
 }
 
@@ -84,14 +88,19 @@ pub fn load_gltf(path: &Path, transform: Mat4) -> Result<GltfModel, SceneError> 
         path,
         base: path.parent().map(Path::to_owned).unwrap_or_default(),
     };
-    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(&bytes).map_err(|err| {
-        SceneError::Asset {
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice(&bytes).map_err(|err| SceneError::Asset {
             path: path.to_owned(),
             message: format!("not a valid glTF file: {err}"),
-        }
-    })?;
-    if document.extensions_used().any(|e| e == "KHR_draco_mesh_compression") {
-        return Err(files.error("extensionsUsed", "Draco-compressed meshes are not supported"));
+        })?;
+    if document
+        .extensions_used()
+        .any(|e| e == "KHR_draco_mesh_compression")
+    {
+        return Err(files.error(
+            "extensionsUsed",
+            "Draco-compressed meshes are not supported",
+        ));
     }
     if document.lights().is_some_and(|mut l| l.next().is_some()) {
         log::warn!(
@@ -151,14 +160,25 @@ impl Walk<'_> {
     fn node(&mut self, node: &gltf::Node, parent: Mat4) -> Result<(), SceneError> {
         let element = format!("node {}", node.index());
         if self.ancestors.contains(&node.index()) {
-            return Err(self.files.error(&element, "is its own ancestor (the node hierarchy has a cycle)"));
+            return Err(self.files.error(
+                &element,
+                "is its own ancestor (the node hierarchy has a cycle)",
+            ));
         }
         if self.ancestors.len() >= MAX_DEPTH {
-            return Err(self.files.error(&element, format!("nodes nest deeper than {MAX_DEPTH}")));
+            return Err(self
+                .files
+                .error(&element, format!("nodes nest deeper than {MAX_DEPTH}")));
         }
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         let world = parent * local;
-        if !world.is_finite() || world.abs().to_cols_array().iter().any(|&v| v > MAX_COORDINATE) {
+        if !world.is_finite()
+            || world
+                .abs()
+                .to_cols_array()
+                .iter()
+                .any(|&v| v > MAX_COORDINATE)
+        {
             return Err(self.files.error(&element, "its transform is not finite"));
         }
         if let Some(camera) = node.camera() {
@@ -230,7 +250,8 @@ impl Walk<'_> {
             let name = format!(
                 "{}/{}#{}.{}",
                 self.stem,
-                mesh.name().map_or_else(|| format!("mesh{}", mesh.index()), str::to_owned),
+                mesh.name()
+                    .map_or_else(|| format!("mesh{}", mesh.index()), str::to_owned),
                 primitive.index(),
                 self.instances
             );

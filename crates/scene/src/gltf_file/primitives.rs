@@ -1,8 +1,8 @@
 //! A glTF mesh primitive's triangles, read into a [`TriangleMesh`] in the mesh's own space.
 
+use glam::{Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
-use glam::{Vec2, Vec3, Vec4};
 
 use super::data::Files;
 use crate::error::SceneError;
@@ -14,7 +14,9 @@ use crate::tangents::mikktspace_tangents;
 /// triangle counter-clockwise from its front); `None` for points and lines.
 pub(super) fn triangles(mode: Mode, count: usize) -> Option<Vec<[usize; 3]>> {
     let tris = match mode {
-        Mode::Triangles => (0..count / 3).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect(),
+        Mode::Triangles => (0..count / 3)
+            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .collect(),
         Mode::TriangleStrip => (0..count.saturating_sub(2))
             .map(|i| [i, i + 1 + i % 2, i + 2 - i % 2])
             .collect(),
@@ -53,7 +55,12 @@ pub(super) fn read_primitive(
     let check = |what: &str, accessor: &gltf::Accessor, dims, types: &[DataType]| {
         files.check_accessor(&format!("{element} {what}"), accessor, buffers, dims, types)
     };
-    check("POSITION", &position_accessor, Dimensions::Vec3, &[DataType::F32])?;
+    check(
+        "POSITION",
+        &position_accessor,
+        Dimensions::Vec3,
+        &[DataType::F32],
+    )?;
     let positions: Vec<Vec3> = reader
         .read_positions()
         .ok_or_else(|| files.error(&element, "cannot read POSITION"))?
@@ -165,7 +172,10 @@ pub(super) fn read_primitive(
                     .map(Vec4::from)
                     .collect();
                 if tangents.len() != count || tangents.iter().any(|t| !t.is_finite()) {
-                    return Err(files.error(&element, "TANGENT does not give a finite tangent per vertex"));
+                    return Err(files.error(
+                        &element,
+                        "TANGENT does not give a finite tangent per vertex",
+                    ));
                 }
                 mesh.indices
                     .iter()
@@ -220,7 +230,10 @@ mod tests {
             vec![[0, 1, 2], [3, 4, 5]]
         );
         assert!(triangles(Mode::LineStrip, 5).is_none());
-        assert_eq!(triangles(Mode::TriangleStrip, 2).unwrap(), Vec::<[usize; 3]>::new());
+        assert_eq!(
+            triangles(Mode::TriangleStrip, 2).unwrap(),
+            Vec::<[usize; 3]>::new()
+        );
     }
 
     #[test]
@@ -237,7 +250,11 @@ mod tests {
         place(&mut mesh, glam::Mat4::from_scale(Vec3::new(-2.0, 1.0, 1.0)));
         let [a, b, c] = mesh.indices[0].map(|i| mesh.positions[i as usize]);
         let face = (b - a).cross(c - a).normalize();
-        assert!(face.distance(mesh.normals[0]) < 1e-6, "{face} vs {}", mesh.normals[0]);
+        assert!(
+            face.distance(mesh.normals[0]) < 1e-6,
+            "{face} vs {}",
+            mesh.normals[0]
+        );
         assert_eq!(mesh.indices[0], [0, 2, 1]);
         for t in &mesh.tangents {
             assert_eq!(*t, Vec4::new(-1.0, 0.0, 0.0, -1.0));

@@ -1,0 +1,296 @@
+//! glTF's metal-rough material and its textures on both backends: white furnaces where the
+//! answer is exact, an alpha-masked quad that shades and shadows like the cut-out shape it
+//! stands for, a normal map that shades like the vertex normals it encodes, and CPU/GPU
+//! agreement on a scene using all of them.
+
+use glam::{Vec2, Vec3};
+use pathlight_core::Film;
+use pathlight_scene::{
+    AlphaMode, Environment, Lobes, Material, MetalRough, Object, Scene, Shape, Texture, TextureRef,
+    TriangleMesh, Wrap,
+};
+
+use crate::common::{render, render_cpu, scene};
+
+/// A metal-rough material of base colour `color`.
+fn metal_rough(name: &str, color: Vec3, pbr: MetalRough) -> Material {
+    Material {
+        name: name.into(),
+        base_color: color,
+        texture: None,
+        emission: Vec3::ZERO,
+        lobes: Lobes::DIFFUSE,
+        conductor: None,
+        metal_rough: Some(pbr),
+    }
+}
+
+/// White furnaces (constant radiance 1) where every path carries weight 1: a smooth white
+/// metal (Schlick with F0 = 1 reflects everything), a smooth thin wall that transmits all
+/// it does not reflect, and smooth solid glass (radiance scaled by 1/eta^2 going in and
+/// eta^2 coming out), on both backends. The sphere must read 1: mean within 0.3%, pixels
+/// within 0.02 (the glass loses what is still inside after max_depth 64: nothing visible).
+#[test]
+fn metal_rough_furnaces_read_one_on_both_backends() {
+    let cases = [
+        (
+            "smooth white metal",
+            MetalRough {
+                metallic: 1.0,
+                roughness: 0.0,
+                ..MetalRough::DEFAULT
+            },
+        ),
+        (
+            "smooth thin wall",
+            MetalRough {
+                roughness: 0.0,
+                transmission: 1.0,
+                ..MetalRough::DEFAULT
+            },
+        ),
+        (
+            "smooth solid glass",
+            MetalRough {
+                roughness: 0.0,
+                transmission: 1.0,
+                thin: false,
+                ..MetalRough::DEFAULT
+            },
+        ),
+    ];
+    for (what, pbr) in cases {
+        let mut s = scene("refs/furnace-1.0.toml", 48, 16, 0);
+        s.settings.max_depth = 64;
+        s.materials[0] = metal_rough(what, Vec3::ONE, pbr);
+        for (backend, film) in [("GPU", render(&s)), ("CPU", render_cpu(&s))] {
+            let (mut sum, mut count, mut worst) = (0.0f64, 0usize, 0.0f64);
+            for y in 0..48 {
+                for x in 0..48 {
+                    let r = ((x as f32 - 23.5).powi(2) + (y as f32 - 23.5).powi(2)).sqrt();
+                    // The sphere's silhouette radius is about 16.5 pixels at 48 px.
+                    if r < 14.0 {
+                        for c in film.pixel(x, y) {
+                            sum += f64::from(c);
+                            count += 1;
+                            worst = worst.max((f64::from(c) - 1.0).abs());
+                        }
+                    }
+                }
+            }
+            let mean = sum / count as f64;
+            println!("{what} ({backend}): mean {mean:.5}, worst pixel off by {worst:.4}");
+            assert!(
+                (mean - 1.0).abs() < 0.003,
+                "{what} ({backend}): mean {mean}"
+            );
+            assert!(
+                worst < 0.02,
+                "{what} ({backend}): a pixel is off by {worst}"
+            );
+        }
+    }
+}
+
+/// The quad `origin + s edge_u + t edge_v` as two triangles with (u, v) = (s, t), normals
+/// `normal` and tangents along `edge_u`.
+fn quad(origin: Vec3, edge_u: Vec3, edge_v: Vec3, normal: Vec3) -> TriangleMesh {
+    let corners = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
+    TriangleMesh {
+        positions: corners
+            .iter()
+            .map(|c| origin + c.x * edge_u + c.y * edge_v)
+            .collect(),
+        normals: vec![normal; 4],
+        uvs: corners.to_vec(),
+        indices: vec![[0, 1, 2], [0, 2, 3]],
+        tangents: vec![edge_u.normalize().extend(1.0); 6],
+        flat: false,
+    }
+}
+
+/// A texture of `width` x 1 texels, each `texel(x)` as RGBA8.
+fn strip(width: u32, texel: impl Fn(u32) -> [u8; 4]) -> Texture {
+    Texture {
+        width,
+        height: 1,
+        texels: (0..width).map(|x| u32::from_le_bytes(texel(x))).collect(),
+    }
+}
+
+/// A white floor (y = 0, 4 x 4) under a grey sky, seen from above, with a 2 x 2 quad at
+/// height 0.5 over its centre made of `occluder`'s material, lit by an emissive quad high
+/// above to one side so that the occluder casts a sharp-ish shadow.
+fn shadow_scene(occluder: Shape, occluder_material: Material, textures: Vec<Texture>) -> Scene {
+    let mut s = scene("refs/furnace-1.0.toml", 48, 8, 3);
+    s.camera.position = Vec3::new(0.0, 5.0, 0.01);
+    s.camera.look_at = Vec3::ZERO;
+    s.environment = Environment::Constant(Vec3::splat(0.2));
+    let floor = metal_rough("floor", Vec3::splat(0.8), MetalRough::DEFAULT);
+    let mut light = metal_rough("light", Vec3::ZERO, MetalRough::DEFAULT);
+    light.emission = Vec3::splat(20.0);
+    s.materials = vec![floor, occluder_material, light];
+    s.textures = textures;
+    s.objects = vec![
+        Object {
+            name: "floor".into(),
+            material: 0,
+            shape: Shape::Mesh(quad(
+                Vec3::new(-2.0, 0.0, 2.0),
+                Vec3::new(4.0, 0.0, 0.0),
+                Vec3::new(0.0, 0.0, -4.0),
+                Vec3::Y,
+            )),
+        },
+        Object {
+            name: "occluder".into(),
+            material: 1,
+            shape: occluder,
+        },
+        Object {
+            name: "light".into(),
+            material: 2,
+            shape: Shape::Mesh(quad(
+                Vec3::new(0.5, 3.0, 0.5),
+                Vec3::new(0.0, 0.0, -1.0),
+                Vec3::new(1.0, 0.0, 0.0),
+                Vec3::NEG_Y,
+            )),
+        },
+    ];
+    s
+}
+
+/// The share of pixels within 2% (relative) of each other, and the two means.
+fn agreement(a: &Film, b: &Film) -> (f64, [f64; 3], [f64; 3]) {
+    let close = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .filter(|(p, q)| (0..3).all(|i| (p[i] - q[i]).abs() <= 0.02 * (1.0 + q[i].abs())))
+        .count();
+    (close as f64 / a.pixels.len() as f64, a.mean(), b.mean())
+}
+
+/// A quad whose texture's left half has alpha 0 (MASK, cutoff 0.5) shades and shadows as
+/// the right half alone does: the same image but for pixels on the cut (CPU and GPU), and
+/// one clearly unlike the whole quad's (so the test can fail).
+#[test]
+fn an_alpha_masked_quad_casts_the_shadow_of_its_opaque_part() {
+    let edge_u = Vec3::new(2.0, 0.0, 0.0);
+    let edge_v = Vec3::new(0.0, 0.0, -2.0);
+    let origin = Vec3::new(-1.0, 0.5, 1.0);
+    // 16 texels: 8 transparent, 8 opaque; bilinear alpha crosses 0.5 at u = 0.5 exactly.
+    let mask = strip(16, |x| [255, 255, 255, if x < 8 { 0 } else { 255 }]);
+    let mut masked = metal_rough(
+        "masked",
+        Vec3::splat(0.5),
+        MetalRough {
+            alpha: AlphaMode::Mask(0.5),
+            ..MetalRough::DEFAULT
+        },
+    );
+    masked.texture = Some(TextureRef {
+        texture: 0,
+        transform: TextureRef::IDENTITY,
+        wrap: [Wrap::Clamp; 2],
+    });
+    let cut_material = metal_rough("cut", Vec3::splat(0.5), MetalRough::DEFAULT);
+    let masked_scene = shadow_scene(
+        Shape::Mesh(quad(origin, edge_u, edge_v, Vec3::Y)),
+        masked,
+        vec![mask],
+    );
+    let cut_scene = shadow_scene(
+        Shape::Mesh(quad(origin + 0.5 * edge_u, 0.5 * edge_u, edge_v, Vec3::Y)),
+        cut_material.clone(),
+        Vec::new(),
+    );
+    let whole_scene = shadow_scene(
+        Shape::Mesh(quad(origin, edge_u, edge_v, Vec3::Y)),
+        cut_material,
+        Vec::new(),
+    );
+    let cut = render_cpu(&cut_scene);
+    for (backend, film) in [
+        ("CPU", render_cpu(&masked_scene)),
+        ("GPU", render(&masked_scene)),
+    ] {
+        let (share, a, b) = agreement(&film, &cut);
+        println!("masked ({backend}) vs cut: {share:.4} of pixels agree; means {a:?} vs {b:?}");
+        assert!(share >= 0.95, "{backend}: only {share} of pixels agree");
+        assert!(
+            (a[1] - b[1]).abs() <= 0.01 * b[1],
+            "{backend}: means {a:?} vs {b:?}"
+        );
+    }
+    let (share, _, _) = agreement(&render_cpu(&whole_scene), &cut);
+    assert!(
+        share < 0.9,
+        "the whole quad looks like the cut one ({share})"
+    );
+}
+
+/// A normal map of one texel holding the tangent-space normal (sin 40deg, 0, cos 40deg)
+/// shades a quad as vertex normals tilted by 40 degrees towards its tangent do: the same
+/// image on both backends up to float rounding (the texel's 8-bit value is what the vertex
+/// normals use), and unlike the untilted quad's.
+#[test]
+fn a_normal_map_shades_like_the_normals_it_encodes() {
+    let texel = [
+        (0.5 + 0.5 * 40f32.to_radians().sin()) * 255.0,
+        127.5,
+        (0.5 + 0.5 * 40f32.to_radians().cos()) * 255.0,
+    ]
+    .map(|c| c.round() as u8);
+    let decoded = Vec3::from(texel.map(|c| f32::from(c) / 255.0 * 2.0 - 1.0));
+    let map = strip(1, |_| [texel[0], texel[1], texel[2], 255]);
+    let (origin, edge_u, edge_v) = (
+        Vec3::new(-1.0, 0.5, 1.0),
+        Vec3::new(2.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, -2.0),
+    );
+    // Tangent +x, bitangent cross(n, t) = cross(y, x) = -z = the direction of +v.
+    let tilted = (decoded.x * Vec3::X + decoded.y * Vec3::NEG_Z + decoded.z * Vec3::Y).normalize();
+    let mapped_material = {
+        let mut m = metal_rough(
+            "mapped",
+            Vec3::splat(0.7),
+            MetalRough {
+                normal_texture: Some(TextureRef {
+                    texture: 0,
+                    transform: TextureRef::IDENTITY,
+                    wrap: [Wrap::Repeat; 2],
+                }),
+                ..MetalRough::DEFAULT
+            },
+        );
+        m.base_color = Vec3::splat(0.7);
+        m
+    };
+    let plain = metal_rough("plain", Vec3::splat(0.7), MetalRough::DEFAULT);
+    let mapped = shadow_scene(
+        Shape::Mesh(quad(origin, edge_u, edge_v, Vec3::Y)),
+        mapped_material,
+        vec![map],
+    );
+    let mut by_normals_mesh = quad(origin, edge_u, edge_v, tilted);
+    by_normals_mesh.tangents.clear();
+    let by_normals = shadow_scene(Shape::Mesh(by_normals_mesh), plain.clone(), Vec::new());
+    let untilted = shadow_scene(
+        Shape::Mesh(quad(origin, edge_u, edge_v, Vec3::Y)),
+        plain,
+        Vec::new(),
+    );
+    let reference = render_cpu(&by_normals);
+    for (backend, film) in [("CPU", render_cpu(&mapped)), ("GPU", render(&mapped))] {
+        let (share, a, b) = agreement(&film, &reference);
+        println!("normal map ({backend}) vs vertex normals: {share:.4} agree; {a:?} vs {b:?}");
+        assert!(share >= 0.99, "{backend}: only {share} of pixels agree");
+    }
+    let (share, _, _) = agreement(&render_cpu(&untilted), &reference);
+    assert!(
+        share < 0.9,
+        "the tilt does not show ({share} of pixels agree)"
+    );
+}
