@@ -572,3 +572,52 @@ fn env_and_lens_options_replace_the_scenes() {
         fails_with(&all, &needles);
     }
 }
+
+#[test]
+fn gltf_files_render_directly_and_camera_numbers_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("box.png");
+    let glb = "crates/scene/tests/data/gltf/BoxTextured-glTF-Binary/BoxTextured.glb";
+    let output = pathlight(&[
+        "render",
+        glb,
+        "--backend",
+        "cpu",
+        "--width",
+        "16",
+        "--height",
+        "9",
+        "--spp",
+        "2",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let image = image::open(&out).unwrap().to_rgb8();
+    assert_eq!(image.dimensions(), (16, 9));
+    // The cube fills the middle (textured, not the grey sky at the corners).
+    let (centre, corner) = (image.get_pixel(8, 4), image.get_pixel(0, 0));
+    assert_ne!(centre, corner);
+    fails_with(
+        &["render", glb, "--camera", "0", "-o", out.to_str().unwrap()],
+        &[
+            "BoxTextured.glb",
+            "has no camera 0: it has 0 perspective camera(s)",
+        ],
+    );
+    fails_with(
+        &["render", "scenes/default.toml", "--camera", "0"],
+        &["--camera chooses a camera of a glTF file"],
+    );
+    fails_with(
+        &[
+            "render",
+            "crates/scene/tests/data/gltf/RecursiveNodes/RecursiveNodes.gltf",
+        ],
+        &["RecursiveNodes.gltf: node 0: is its own ancestor"],
+    );
+}

@@ -289,6 +289,8 @@ fn texture_transforms_and_samplers_are_read() {
         .filter_map(|m| m.texture)
         .find(|t| t.transform[0][1] != 0.0)
         .expect("a rotated texture");
+    // The file's number (pi / 8 rounded to 6 digits).
+    #[allow(clippy::approx_constant)]
     let (s, c) = 0.392_699f32.sin_cos();
     let expected = [[c, s, 0.0], [-s, c, 0.0]];
     for (row, want) in rotated.transform.iter().zip(expected) {
