@@ -200,6 +200,16 @@ pub struct GpuTextureSlot {
 }
 const _: () = assert!(size_of::<GpuTextureSlot>() == 32);
 
+impl GpuTextureSlot {
+    /// No texture (and the identity coordinate map).
+    pub const NONE: Self = Self {
+        u: [1.0, 0.0, 0.0],
+        texture: -1,
+        v: [0.0, 1.0, 0.0],
+        wrap: 0,
+    };
+}
+
 /// A material in linear RGB. WGSL: `Material`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]

@@ -111,7 +111,7 @@ fn gpu_material(m: &Material) -> GpuMaterial {
         eta: Vec3::ONE,
         k: Vec3::ZERO,
     });
-    let mut slots = [texture_slot(None); 4];
+    let mut slots = [GpuTextureSlot::NONE; 4];
     slots[SLOT_BASE] = texture_slot(m.texture.as_ref());
     let mut out = GpuMaterial {
         base_color: m.base_color.to_array(),
@@ -163,12 +163,7 @@ fn gpu_material(m: &Material) -> GpuMaterial {
 /// A texture use as the shaders read it; texture -1 for none.
 fn texture_slot(r: Option<&TextureRef>) -> GpuTextureSlot {
     let Some(r) = r else {
-        return GpuTextureSlot {
-            u: [1.0, 0.0, 0.0],
-            texture: -1,
-            v: [0.0, 1.0, 0.0],
-            wrap: 0,
-        };
+        return GpuTextureSlot::NONE;
     };
     let mode = |w: Wrap| match w {
         Wrap::Repeat => WRAP_REPEAT,

@@ -46,12 +46,7 @@ fn material(
         alpha_cutoff: 0.0,
         alpha_factor: 1.0,
         flags: 0,
-        slots: [GpuTextureSlot {
-            u: [1.0, 0.0, 0.0],
-            texture: -1,
-            v: [0.0, 1.0, 0.0],
-            wrap: 0,
-        }; 4],
+        slots: [GpuTextureSlot::NONE; 4],
     }
 }
 

@@ -387,14 +387,7 @@ impl Builder<'_, '_> {
         if !(ior.is_finite() && ior > 0.0) {
             return Err(self.invalid(span, format!("{} = {ior} must be > 0", key("ior"))));
         }
-        let texture = match &m.texture {
-            Some(path) => Some(TextureRef::plain(self.texture(
-                span.clone(),
-                &key("texture"),
-                path,
-            )?)),
-            None => None,
-        };
+        let texture = self.base_texture(span.clone(), name, m)?;
         let lobes = Lobes {
             specular_rate,
             specular_tint: self.unit(
@@ -468,14 +461,7 @@ impl Builder<'_, '_> {
         if !(ior.is_finite() && ior >= 1.0) {
             return Err(self.invalid(span, format!("{} = {ior} must be >= 1", key("ior"))));
         }
-        let texture = match &m.texture {
-            Some(path) => Some(TextureRef::plain(self.texture(
-                span.clone(),
-                &key("texture"),
-                path,
-            )?)),
-            None => None,
-        };
+        let texture = self.base_texture(span.clone(), name, m)?;
         Ok(Material {
             name: name.to_owned(),
             base_color,
@@ -499,6 +485,20 @@ impl Builder<'_, '_> {
                 ..MetalRough::DEFAULT
             }),
         })
+    }
+
+    /// The texture a material's `texture` key names, placed as scene files place it.
+    fn base_texture(
+        &mut self,
+        span: Range<usize>,
+        name: &str,
+        m: &MaterialDesc,
+    ) -> Result<Option<TextureRef>, SceneError> {
+        let Some(path) = &m.texture else {
+            return Ok(None);
+        };
+        let key = format!("materials.{name}.texture");
+        Ok(Some(TextureRef::plain(self.texture(span, &key, path)?)))
     }
 
     /// Adds the objects, materials and textures of a `[[gltf]]` entry.
