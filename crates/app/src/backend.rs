@@ -6,8 +6,8 @@ use std::sync::Arc;
 use anyhow::Context;
 use pathlight_core::{PreparedScene, Renderer};
 use pathlight_cpu::{CpuRenderer, InstructionSet};
-use pathlight_render::context::{AutoChoice, auto_choice, available_adapters, describe};
-use pathlight_render::{Accel, GpuContext, GpuRenderer};
+use pathlight_gpu::context::{AutoChoice, auto_choice, available_adapters, describe};
+use pathlight_gpu::{Accel, GpuContext, GpuRenderer};
 use pathlight_scene::settings::{check_max_depth, check_resolution};
 use pathlight_scene::{
     Environment, HdrImage, Sampler, Scene, default_scene, gltf_scene, load_scene_file,

@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::bail;
 use pathlight_core::PreparedScene;
-use pathlight_render::Accel;
+use pathlight_gpu::Accel;
 use pathlight_scene::Scene;
 use serde::Serialize;
 

@@ -186,7 +186,7 @@ pub enum AccelArg {
     BruteForce,
 }
 
-impl From<AccelArg> for pathlight_render::Accel {
+impl From<AccelArg> for pathlight_gpu::Accel {
     fn from(arg: AccelArg) -> Self {
         match arg {
             AccelArg::Bvh => Self::Bvh,

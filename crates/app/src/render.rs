@@ -8,8 +8,8 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use pathlight_core::state::{Fingerprint, RenderState};
 use pathlight_core::{Accumulation, PreparedScene, Renderer};
-use pathlight_render::Accel;
-use pathlight_render::context::{available_adapters, describe};
+use pathlight_gpu::Accel;
+use pathlight_gpu::context::{available_adapters, describe};
 use pathlight_scene::Scene;
 use pathlight_scene::settings::check_spp;
 

@@ -1,5 +1,5 @@
 //! Renders that survive and scale, end to end on the CPU backend (the GPU backend's resume
-//! and splits are checked in-process by `crates/render/tests/gpu/state.rs`): state files,
+//! and splits are checked in-process by `crates/gpu/tests/gpu/state.rs`): state files,
 //! checkpoints, resuming after SIGINT, SIGTERM and SIGKILL, time limits, shards and merges,
 //! each compared byte for byte with the image one uninterrupted render makes.
 

@@ -1,9 +1,9 @@
-//! Every host struct that WGSL also declares (in `crates/render/shaders/scene.wgsl`,
+//! Every host struct that WGSL also declares (in `crates/gpu/shaders/scene.wgsl`,
 //! `camera.wgsl` and `integrator.wgsl`; each declaration names its host struct here).
 //!
 //! Every struct is `#[repr(C)]` + `Pod`, uses no `vec3` without the scalar that pads it to
 //! 16 bytes, and is pinned in size here and in field offsets by a naga test in
-//! `crates/render/tests/shaders.rs`.
+//! `crates/gpu/tests/shaders.rs`.
 
 use bytemuck::{Pod, Zeroable};
 
@@ -156,26 +156,21 @@ pub struct GpuPrimitive {
 }
 const _: () = assert!(size_of::<GpuPrimitive>() == 48);
 
-/// [`GpuMaterial::model`]: the seed's lobe mixture.
-pub const MODEL_LOBES: u32 = 0;
-/// [`GpuMaterial::model`]: glTF's metal-rough model.
-pub const MODEL_METAL_ROUGH: u32 = 1;
-
-/// [`GpuMaterial::flags`] bit: transmission through a thin wall.
-pub const MATERIAL_THIN: u32 = 1;
 /// [`GpuMaterial::flags`] bit: texels with alpha below `alpha_cutoff` are holes.
-pub const MATERIAL_MASK: u32 = 2;
+pub const MATERIAL_MASK: u32 = 1;
 /// [`GpuMaterial::flags`] bit: alpha is the probability that a ray stops.
-pub const MATERIAL_BLEND: u32 = 4;
-
-/// [`GpuMaterial::slots`]: the base colour (sRGB; alpha in its fourth channel).
-pub const SLOT_BASE: usize = 0;
-/// [`GpuMaterial::slots`]: metallic (blue) and roughness (green), linear.
-pub const SLOT_METAL_ROUGH: usize = 1;
-/// [`GpuMaterial::slots`]: the tangent-space normal map, linear.
-pub const SLOT_NORMAL: usize = 2;
-/// [`GpuMaterial::slots`]: the emission, sRGB.
-pub const SLOT_EMISSION: usize = 3;
+pub const MATERIAL_BLEND: u32 = 2;
+/// A material's texture `TEXTURE_*` is slot `textures + TEXTURE_*` of the texture slots,
+/// present when bit `TEXTURE_*` of `texture_mask` is set: the base colour (sRGB; alpha in
+/// its fourth channel).
+pub const TEXTURE_BASE: u32 = 0;
+/// [`TEXTURE_BASE`]'s kin: the tangent-space normal map (linear).
+pub const TEXTURE_NORMAL: u32 = 1;
+/// [`TEXTURE_BASE`]'s kin: the emission (sRGB).
+pub const TEXTURE_EMISSION: u32 = 2;
+/// [`TEXTURE_BASE`]'s kin: the model's own textures, from this index on, in the order its
+/// kernel file names them.
+pub const TEXTURE_MODEL: u32 = 3;
 
 /// [`GpuTextureSlot::wrap`] mode (2 bits per axis, u in the low bits): tile.
 pub const WRAP_REPEAT: u32 = 0;
@@ -184,96 +179,80 @@ pub const WRAP_CLAMP: u32 = 1;
 /// [`GpuTextureSlot::wrap`] mode: tile, every other copy mirrored.
 pub const WRAP_MIRROR: u32 = 2;
 
-/// One use of a texture by a material: which texture, the affine map from surface to
-/// texture coordinates and the wrapping. WGSL: `TextureSlot`.
+/// One use of a texture by a material: where its texels lie, the affine map from surface
+/// to texture coordinates and the wrapping (all zero for a texture the material lacks).
+/// WGSL: `TextureSlot`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuTextureSlot {
     /// Texture u = dot(u.xy, uv) + u.z.
     pub u: [f32; 3],
-    /// Index into the texture table, or -1 for none.
-    pub texture: i32,
+    /// The texture's first texel in the texel buffer.
+    pub offset: u32,
     /// Texture v = dot(v.xy, uv) + v.z.
     pub v: [f32; 3],
     /// `WRAP_*` of u, then of v shifted left by 2.
     pub wrap: u32,
-}
-const _: () = assert!(size_of::<GpuTextureSlot>() == 32);
-
-impl GpuTextureSlot {
-    /// No texture (and the identity coordinate map).
-    pub const NONE: Self = Self {
-        u: [1.0, 0.0, 0.0],
-        texture: -1,
-        v: [0.0, 1.0, 0.0],
-        wrap: 0,
-    };
-}
-
-/// A material in linear RGB. WGSL: `Material`.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct GpuMaterial {
-    /// Base colour (multiplied by the base texture under the metal-rough model, replaced
-    /// by it under the lobes).
-    pub base_color: [f32; 3],
-    /// `MODEL_*`.
-    pub model: u32,
-    /// Emitted radiance (front side), multiplied by the emission texture.
-    pub emission: [f32; 3],
-    /// Weight of the specular lobe.
-    pub specular_rate: f32,
-    /// Conductor IOR, real part (when `conductor` is 1).
-    pub eta: [f32; 3],
-    /// Specular colour between white and base colour.
-    pub specular_tint: f32,
-    /// Conductor IOR, imaginary part (when `conductor` is 1).
-    pub k: [f32; 3],
-    /// Roughness of the specular lobe.
-    pub specular_roughness: f32,
-    /// Weight of the transmission lobe.
-    pub refract_rate: f32,
-    /// Transmitted colour between white and base colour.
-    pub refract_tint: f32,
-    /// Index of refraction of the inside (both models).
-    pub ior: f32,
-    /// Roughness of transmission.
-    pub refract_roughness: f32,
-    /// 1: the specular lobe uses the complex-IOR conductor Fresnel; 0: Schlick.
-    pub conductor: u32,
-    /// Metal-rough: 0 dielectric, 1 metal.
-    pub metallic: f32,
-    /// Metal-rough: perceptual roughness.
-    pub roughness: f32,
-    /// Metal-rough: fraction of the dielectric base that transmits.
-    pub transmission: f32,
-    /// Metal-rough: scale of the normal map's x and y.
-    pub normal_scale: f32,
-    /// Metal-rough: alpha below which a masked texel is a hole.
-    pub alpha_cutoff: f32,
-    /// Metal-rough: base colour alpha factor.
-    pub alpha_factor: f32,
-    /// `MATERIAL_*` bits.
-    pub flags: u32,
-    /// The textures, by `SLOT_*`.
-    pub slots: [GpuTextureSlot; 4],
-}
-const _: () = assert!(size_of::<GpuMaterial>() == 240);
-
-/// Where a texture's texels lie in the texel buffer. WGSL: `TextureInfo`.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct GpuTextureInfo {
-    /// First texel.
-    pub offset: u32,
     /// Width in texels.
     pub width: u32,
     /// Height in texels.
     pub height: u32,
     /// Padding.
-    pub pad: u32,
+    pub pad: [u32; 2],
 }
-const _: () = assert!(size_of::<GpuTextureInfo>() == 16);
+const _: () = assert!(size_of::<GpuTextureSlot>() == 48);
+
+/// A material's common part in linear RGB; its model's parameters are a block of
+/// `vec4f`s in the material parameter buffer ([`crate::materials`] writes both, each model's
+/// kernel file reads its block). A new model changes neither this struct nor its layout.
+/// WGSL: `Material`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuMaterial {
+    /// Base colour, multiplied by the base texture.
+    pub base_color: [f32; 3],
+    /// `MODEL_*` of [`crate::materials`].
+    pub model: u32,
+    /// Emitted radiance (front side), multiplied by the emission texture.
+    pub emission: [f32; 3],
+    /// `MATERIAL_*` bits.
+    pub flags: u32,
+    /// Alpha below which a masked texel is a hole.
+    pub alpha_cutoff: f32,
+    /// Base colour alpha factor.
+    pub alpha_factor: f32,
+    /// Scale of the normal map's x and y.
+    pub normal_scale: f32,
+    /// Index of its model's first parameter vector in the parameter buffer.
+    pub params: u32,
+    /// Index of its first texture slot (see [`TEXTURE_BASE`]).
+    pub textures: u32,
+    /// Bit `TEXTURE_*` set when the material has that texture; 0 for none.
+    pub texture_mask: u32,
+    /// Padding.
+    pub pad: [u32; 2],
+}
+const _: () = assert!(size_of::<GpuMaterial>() == 64);
+
+impl GpuMaterial {
+    /// A black, non-emissive, opaque and untextured material of model `model` (a `MODEL_*`
+    /// of [`crate::materials`]) whose parameters start at vector `params`.
+    pub const fn new(model: u32, params: u32) -> Self {
+        Self {
+            base_color: [0.0; 3],
+            model,
+            emission: [0.0; 3],
+            flags: 0,
+            alpha_cutoff: 0.0,
+            alpha_factor: 1.0,
+            normal_scale: 1.0,
+            params,
+            textures: 0,
+            texture_mask: 0,
+            pad: [0; 2],
+        }
+    }
+}
 
 /// The camera as the integrator reads it: the eye and the image plane at unit distance.
 /// WGSL: `CameraParams`.

@@ -11,6 +11,7 @@ pub mod film;
 pub mod geometry;
 pub mod gpu_types;
 pub mod light_table;
+pub mod materials;
 pub mod octahedral;
 pub mod params;
 pub mod prepared;

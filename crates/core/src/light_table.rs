@@ -107,7 +107,7 @@ mod tests {
     use pathlight_scene::{Material, Scene, Shape};
 
     use crate::gpu_types::NO_LIGHT;
-    use crate::{Geometry, Shading};
+    use crate::{Geometry, Shading, Textures};
 
     /// A scene whose material 1 emits `emission`, with a 2x1 quad, a sphere of radius 0.5
     /// and a mesh of two triangles (areas 0.5 and 2) in it, and a grey sphere.
@@ -160,7 +160,7 @@ mod tests {
     fn entries_are_chosen_by_power_and_objects_point_at_them() {
         let scene = lit(Vec3::splat(2.0));
         let geometry = Geometry::build(&scene.objects).unwrap();
-        let shading = Shading::build(&scene, &geometry);
+        let shading = Shading::build(&scene, &geometry, &Textures::build(&[]));
         // One entry per shape, one per mesh triangle; the grey sphere has none.
         assert_eq!(shading.light_count, 4);
         let areas = [2.0, std::f32::consts::PI, 0.5, 2.0];
@@ -198,7 +198,7 @@ mod tests {
     fn without_emission_or_area_the_table_is_a_placeholder() {
         let dark = lit(Vec3::ZERO);
         let geometry = Geometry::build(&dark.objects).unwrap();
-        let shading = Shading::build(&dark, &geometry);
+        let shading = Shading::build(&dark, &geometry, &Textures::build(&[]));
         assert_eq!((shading.light_count, shading.lights.len()), (0, 1));
         assert!(shading.objects.iter().all(|o| o.light == NO_LIGHT));
         // Emitters of zero area cannot be sampled (or hit): no entries either.
@@ -210,6 +210,9 @@ mod tests {
             edge_v: Vec3::X,
         };
         let geometry = Geometry::build(&flat.objects).unwrap();
-        assert_eq!(Shading::build(&flat, &geometry).light_count, 0);
+        assert_eq!(
+            Shading::build(&flat, &geometry, &Textures::build(&[])).light_count,
+            0
+        );
     }
 }

@@ -17,7 +17,7 @@ use crate::textures::Textures;
 pub struct PreparedScene {
     /// Shapes, triangles and the BVH.
     pub geometry: Arc<Geometry>,
-    /// Texels.
+    /// Texels, and where each texture lies.
     pub textures: Arc<Textures>,
     /// The environment map's texels and sampling distribution (placeholders without one).
     pub environment: Arc<EnvironmentData>,
@@ -30,10 +30,11 @@ impl PreparedScene {
     /// beyond the coordinate limit.
     pub fn new(scene: &Scene) -> Result<Self, GeometryError> {
         let geometry = Geometry::build(&scene.objects)?;
-        let shading = Shading::build(scene, &geometry);
+        let textures = Textures::build(&scene.textures);
+        let shading = Shading::build(scene, &geometry, &textures);
         Ok(Self {
             geometry: Arc::new(geometry),
-            textures: Arc::new(Textures::build(&scene.textures)),
+            textures: Arc::new(textures),
             environment: Arc::new(match &scene.environment {
                 Environment::Map(map) => EnvironmentData::build(&map.image),
                 Environment::Constant(_) => EnvironmentData::none(),
@@ -47,6 +48,6 @@ impl PreparedScene {
     /// must be this scene's, its strength and rotation may differ). Textures are kept: a
     /// material may only use the textures the scene was prepared with.
     pub fn shading_of(&self, scene: &Scene) -> Shading {
-        Shading::build(scene, &self.geometry)
+        Shading::build(scene, &self.geometry, &self.textures)
     }
 }

@@ -5,7 +5,7 @@
 use glam::{Vec3, Vec3A};
 use pathlight_core::PreparedScene;
 use pathlight_core::gpu_types::{
-    GpuLight, GpuMaterial, GpuObject, GpuPrimitive, GpuTextureInfo, GpuVertex, GpuWideNode,
+    GpuLight, GpuMaterial, GpuObject, GpuPrimitive, GpuTextureSlot, GpuVertex, GpuWideNode,
     KIND_QUAD,
 };
 
@@ -22,12 +22,14 @@ pub struct CpuScene<'a> {
     pub vertices: &'a [GpuVertex],
     /// Objects with their materials (WGSL `objects`).
     pub objects: &'a [GpuObject],
-    /// Materials (WGSL `materials`).
+    /// Materials' common parts (WGSL `materials`).
     pub materials: &'a [GpuMaterial],
+    /// Their models' parameter blocks (WGSL `material_params`).
+    pub material_params: &'a [[f32; 4]],
+    /// Their texture slots (WGSL `texture_slots`).
+    pub texture_slots: &'a [GpuTextureSlot],
     /// The light table (WGSL `lights`).
     pub lights: &'a [GpuLight],
-    /// The texture table (WGSL `textures`).
-    pub textures: &'a [GpuTextureInfo],
     /// Texels (WGSL `texels`).
     pub texels: &'a [u32],
     /// The environment map's RGB9E5 texels (WGSL `env_texels`).
@@ -58,8 +60,9 @@ impl<'a> CpuScene<'a> {
             vertices: &scene.geometry.vertices,
             objects,
             materials: &scene.shading.materials,
+            material_params: &scene.shading.material_params,
+            texture_slots: &scene.shading.texture_slots,
             lights: &scene.shading.lights,
-            textures: &scene.textures.infos,
             texels: &scene.textures.texels,
             env_texels: &scene.environment.texels,
             env_distribution: &scene.environment.distribution,

@@ -10,10 +10,10 @@ use crate::cpu_scene::CpuScene;
 use crate::environment::env_radiance;
 use crate::intersect::Ray;
 use crate::lights::{LightSample, env_pdf, light_pdf, sample_light};
-use crate::metal_rough::{eval_material, has_continuous_material_lobe, sample_material};
+use crate::material::{eval_material, has_continuous_material_lobe, material_at, sample_material};
 use crate::sampler::{Draw, Sampler};
 use crate::sampling::power_heuristic;
-use crate::surface::{material_at, surface_at};
+use crate::surface::surface_at;
 
 /// Largest radiance one sample may add per channel (WGSL `SAMPLE_MAX`).
 pub const SAMPLE_MAX: f32 = 16_777_216.0;
@@ -143,9 +143,9 @@ impl Path {
             return None;
         };
         let s = surface_at(scene, &hit, &ray);
-        let material = &material_at(scene, &scene.materials[s.material as usize], s.uv);
+        let material = &material_at(scene, s.material, s.uv);
         let wo = -Vec3A::from(ray.dir);
-        let emission = Vec3A::from(material.emission);
+        let emission = material.emission;
         if wo.dot(s.ng) > 0.0 && emission.max_element() > 0.0 {
             let object = &scene.objects[hit.object as usize];
             let w = if self.prev_delta || object.light == NO_LIGHT {

@@ -5,7 +5,6 @@
 //! traced in packets ([`packet`]) through the 4-wide BVH both backends walk. The tests
 //! render scenes on both backends and compare.
 
-pub mod bsdf;
 pub mod bvh;
 pub mod camera;
 pub mod cpu_scene;
@@ -14,7 +13,10 @@ pub mod environment;
 pub mod integrator;
 pub mod intersect;
 pub mod lights;
+pub mod lobes;
+pub mod material;
 pub mod metal_rough;
+pub mod microfacet;
 pub mod packet;
 mod row;
 pub mod sampler;

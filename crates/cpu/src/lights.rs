@@ -18,10 +18,10 @@ use pathlight_core::light_table;
 use crate::cpu_scene::CpuScene;
 use crate::environment::{env_map_pdf, env_radiance, has_env_map, sample_env_map};
 use crate::intersect::{MISS, Ray, intersect_sphere};
+use crate::material::emission_at;
 use crate::sampling::{
     Frame, sample_cosine_hemisphere, sample_disk, sample_uniform_sphere, sin_cos_turns,
 };
-use crate::surface::material_at;
 use crate::textures::triangle_uv;
 
 /// A sampled light direction. Twin of WGSL `LightSample`.
@@ -276,14 +276,13 @@ pub fn sample_light(
     } else {
         pmf * density * distance * distance / cos_l
     };
-    let material = &scene.materials[o.material as usize];
     let radiance = if o.kind == KIND_MESH {
         // The barycentrics `sample_shape` drew the point at.
         let su = u.x.sqrt();
         let uv = triangle_uv(scene, light.primitive, 1.0 - su, u.y * su);
-        Vec3A::from(material_at(scene, material, uv).emission)
+        emission_at(scene, o.material, uv)
     } else {
-        Vec3A::from(material.emission)
+        Vec3A::from(scene.materials[o.material as usize].emission)
     };
     LightSample {
         wi,

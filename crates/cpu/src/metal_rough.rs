@@ -1,5 +1,4 @@
-//! glTF 2.0's metal-rough material, and the choice between it and the lobe model of
-//! [`crate::bsdf`]. Twin of `metal_rough.wgsl`.
+//! glTF 2.0's metallic-roughness material model. Twin of `metal_rough.wgsl`.
 //!
 //! With base colour `c`, metallic `m`, transmission `t`, roughness `r` (GGX alpha = r^2)
 //! and dielectric Schlick F0 `f0 = ((ior - 1) / (ior + 1))^2`, the BSDF is the sum of
@@ -14,22 +13,73 @@
 //! - a dielectric interface weighted `(1 - m) t` (`KHR_materials_transmission`): a thin wall
 //!   (exact Fresnel; the transmitted direction is the reflected one mirrored through the
 //!   surface, tinted by `c`; smooth, it passes straight through) or, with
-//!   `KHR_materials_volume`, the rough dielectric of the lobe model tinted by `c`.
+//!   `KHR_materials_volume`, the rough dielectric of [`crate::microfacet`] tinted by `c`.
 //!
 //! Lobes are sampled in proportion to their estimated albedo at `wo`.
 
 use std::f32::consts::FRAC_1_PI;
 
-use glam::{Vec2, Vec3A};
-use pathlight_core::gpu_types::{GpuMaterial, MATERIAL_THIN, MODEL_METAL_ROUGH};
+use glam::{Vec2, Vec3A, Vec4};
+use pathlight_core::gpu_types::{GpuMaterial, TEXTURE_MODEL};
 
-use crate::bsdf::{
-    ALPHA_MIN, BsdfEval, BsdfSample, INVALID, eval_bsdf, eval_rough_dielectric, fresnel_dielectric,
-    ggx_d, ggx_g1, ggx_sample_visible, has_continuous_lobe, rough_dielectric_direction,
-    sample_bsdf, sample_smooth_dielectric,
+use crate::cpu_scene::CpuScene;
+use crate::material::MODEL_PARAMS;
+use crate::microfacet::{
+    ALPHA_MIN, BsdfEval, BsdfSample, INVALID, continuous_sample, eval_rough_dielectric,
+    fresnel_dielectric, ggx_d, ggx_g1, ggx_sample_visible, rough_dielectric_direction,
+    sample_smooth_dielectric,
 };
 use crate::sampling::{Frame, sample_cosine_hemisphere};
 use crate::surface::Surface;
+use crate::textures::{has_texture, material_texture};
+
+/// The model's parameters: its block of the material parameters, as
+/// `pathlight_core::materials` lays it out (`metal_rough_block`), with its texture
+/// applied. Twin of WGSL `MetalRoughParams`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MetalRoughParams {
+    /// 0 dielectric, 1 metal.
+    pub metallic: f32,
+    /// Perceptual roughness; GGX alpha is its square.
+    pub roughness: f32,
+    /// Fraction of the dielectric base that transmits.
+    pub transmission: f32,
+    /// Index of refraction of the dielectric.
+    pub ior: f32,
+    /// Transmission through a thin wall rather than into a volume.
+    pub thin: bool,
+}
+
+impl MetalRoughParams {
+    /// The parameters in block `p`. Twin of WGSL `metal_rough_params`.
+    #[inline(always)]
+    pub fn decode(p: &[Vec4; MODEL_PARAMS]) -> Self {
+        Self {
+            metallic: p[0].x,
+            roughness: p[0].y,
+            transmission: p[0].z,
+            ior: p[0].w,
+            thin: p[1].x != 0.0,
+        }
+    }
+}
+
+/// The model's texture step on block `p`: metallic times the blue and roughness times the
+/// green channel of its texture (slot [`TEXTURE_MODEL`], linear) at `uv`. Twin of WGSL
+/// `metal_rough_textured`.
+#[inline(always)]
+pub fn metal_rough_textured(
+    scene: &CpuScene,
+    p: &mut [Vec4; MODEL_PARAMS],
+    m: &GpuMaterial,
+    uv: Vec2,
+) {
+    if has_texture(m, TEXTURE_MODEL) {
+        let t = material_texture(scene, m, TEXTURE_MODEL, uv);
+        p[0].y *= t.y;
+        p[0].x *= t.z;
+    }
+}
 
 /// The model's lobe weights. Twin of WGSL `MetalRoughLobes`.
 #[derive(Debug, Clone, Copy)]
@@ -48,13 +98,13 @@ pub struct Lobes {
 
 /// Twin of WGSL `mr_lobes`.
 #[inline(always)]
-pub fn lobes(m: &GpuMaterial) -> Lobes {
+pub fn lobes(m: &MetalRoughParams, color: Vec3A) -> Lobes {
     let r = (m.ior - 1.0) / (m.ior + 1.0);
     let f0_d = r * r;
     let dielectric = 1.0 - m.metallic;
     let base = dielectric * (1.0 - m.transmission);
     Lobes {
-        spec_f0: m.metallic * Vec3A::from(m.base_color) + Vec3A::splat(base * f0_d),
+        spec_f0: m.metallic * color + Vec3A::splat(base * f0_d),
         spec_f90: m.metallic + base,
         diffuse: base,
         wall: dielectric * m.transmission,
@@ -77,10 +127,10 @@ fn schlick_d(f0: f32, cos_i: f32) -> f32 {
 /// Probabilities of sampling the specular lobe, the diffuse base and the interface. Twin
 /// of WGSL `mr_probabilities`.
 #[inline(always)]
-fn probabilities(m: &GpuMaterial, l: &Lobes, cos_o: f32) -> Vec3A {
+fn probabilities(color: Vec3A, l: &Lobes, cos_o: f32) -> Vec3A {
     let lum = Vec3A::new(0.2126, 0.7152, 0.0722);
     let spec = schlick(l.spec_f0, l.spec_f90, cos_o).dot(lum);
-    let diffuse = l.diffuse * Vec3A::from(m.base_color).dot(lum) * (1.0 - schlick_d(l.f0_d, cos_o));
+    let diffuse = l.diffuse * color.dot(lum) * (1.0 - schlick_d(l.f0_d, cos_o));
     let total = spec + diffuse + l.wall;
     if total > 0.0 {
         Vec3A::new(spec, diffuse, l.wall) / total
@@ -91,15 +141,14 @@ fn probabilities(m: &GpuMaterial, l: &Lobes, cos_o: f32) -> Vec3A {
 
 /// The continuous part of the BSDF. Twin of WGSL `eval_metal_rough`.
 #[inline(always)]
-pub fn eval(m: &GpuMaterial, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfEval {
+pub fn eval(m: &MetalRoughParams, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfEval {
     let sign = if wo.dot(s.ng) >= 0.0 { 1.0 } else { -1.0 };
     let (ng, n) = (s.ng * sign, s.ns * sign);
-    let l = lobes(m);
+    let l = lobes(m, color);
     let (cos_o, cos_i) = (wo.dot(n), wi.dot(n));
-    let probs = probabilities(m, &l, cos_o);
+    let probs = probabilities(color, &l, cos_o);
     let alpha = m.roughness * m.roughness;
-    let thin = m.flags & MATERIAL_THIN != 0;
-    let color = Vec3A::from(m.base_color);
+    let thin = m.thin;
     let mut out = BsdfEval {
         f: Vec3A::ZERO,
         pdf: 0.0,
@@ -145,11 +194,7 @@ pub fn eval(m: &GpuMaterial, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfEval {
                 out.pdf += probs.z * ft * g1o * d / (4.0 * wo_l.z);
             }
         } else {
-            let glass = GpuMaterial {
-                refract_tint: 1.0,
-                ..*m
-            };
-            let e = eval_rough_dielectric(&glass, color, s, wo, wi, alpha);
+            let e = eval_rough_dielectric(m.ior, color, 1.0, s, wo, wi, alpha);
             out.f += l.wall * e.f;
             out.pdf += probs.z * e.pdf;
         }
@@ -157,27 +202,18 @@ pub fn eval(m: &GpuMaterial, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfEval {
     out
 }
 
-/// `eval / pdf` of a continuous sample. Twin of WGSL `mr_mixture_sample`.
+/// `eval / pdf` of a continuous sample; a thin wall refracts nothing. Twin of WGSL
+/// `mr_mixture_sample`.
 #[inline(always)]
-fn mixture_sample(m: &GpuMaterial, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfSample {
-    let e = eval(m, s, wo, wi);
-    if e.pdf <= 0.0 || !e.pdf.is_finite() {
-        return INVALID;
-    }
-    let front_o = wo.dot(s.ng) >= 0.0;
-    let eta = if front_o != (wi.dot(s.ng) >= 0.0) && m.flags & MATERIAL_THIN == 0 {
-        if front_o { m.ior } else { 1.0 / m.ior }
-    } else {
-        1.0
-    };
-    BsdfSample {
-        wi,
-        weight: e.f / e.pdf,
-        pdf: e.pdf,
-        delta: false,
-        eta,
-        valid: true,
-    }
+fn mixture_sample(
+    m: &MetalRoughParams,
+    color: Vec3A,
+    s: &Surface,
+    wo: Vec3A,
+    wi: Vec3A,
+) -> BsdfSample {
+    let ior = if m.thin { 1.0 } else { m.ior };
+    continuous_sample(eval(m, color, s, wo, wi), s, wo, wi, ior)
 }
 
 /// A delta sample of weight `weight`.
@@ -195,7 +231,8 @@ fn delta(wi: Vec3A, weight: Vec3A, valid: bool) -> BsdfSample {
 /// Samples an incident direction. Twin of WGSL `sample_metal_rough`.
 #[inline(always)]
 pub fn sample(
-    m: &GpuMaterial,
+    m: &MetalRoughParams,
+    color: Vec3A,
     s: &Surface,
     wo: Vec3A,
     u_lobe: f32,
@@ -208,12 +245,11 @@ pub fn sample(
     if cos_o <= 0.0 {
         return INVALID;
     }
-    let l = lobes(m);
-    let probs = probabilities(m, &l, cos_o);
+    let l = lobes(m, color);
+    let probs = probabilities(color, &l, cos_o);
     let alpha = m.roughness * m.roughness;
     let frame = Frame::around(n);
     let wo_l = frame.to_local(wo);
-    let color = Vec3A::from(m.base_color);
     if u_lobe < probs.x {
         if alpha < ALPHA_MIN {
             let wi = 2.0 * cos_o * n - wo;
@@ -227,10 +263,10 @@ pub fn sample(
         if wi_l.z <= 0.0 {
             return INVALID;
         }
-        return mixture_sample(m, s, wo, frame.to_world(wi_l));
+        return mixture_sample(m, color, s, wo, frame.to_world(wi_l));
     }
     if u_lobe < probs.x + probs.z {
-        if m.flags & MATERIAL_THIN != 0 {
+        if m.thin {
             if alpha < ALPHA_MIN {
                 let fr = fresnel_dielectric(cos_o, m.ior);
                 if u_fresnel < fr {
@@ -250,19 +286,15 @@ pub fn sample(
             } else {
                 Vec3A::new(wr_l.x, wr_l.y, -wr_l.z)
             };
-            return mixture_sample(m, s, wo, frame.to_world(wi_l));
+            return mixture_sample(m, color, s, wo, frame.to_world(wi_l));
         }
         if alpha < ALPHA_MIN {
-            let glass = GpuMaterial {
-                refract_tint: 1.0,
-                ..*m
-            };
-            let mut bs = sample_smooth_dielectric(&glass, color, s, wo, u_fresnel);
+            let mut bs = sample_smooth_dielectric(m.ior, color, 1.0, s, wo, u_fresnel);
             bs.weight *= l.wall / probs.z;
             return bs;
         }
         return match rough_dielectric_direction(m.ior, s, wo, alpha, u_fresnel, u) {
-            Some(wi) => mixture_sample(m, s, wo, wi),
+            Some(wi) => mixture_sample(m, color, s, wo, wi),
             None => INVALID,
         };
     }
@@ -270,42 +302,11 @@ pub fn sample(
     if wi.dot(ng) <= 0.0 {
         return INVALID;
     }
-    mixture_sample(m, s, wo, wi)
+    mixture_sample(m, color, s, wo, wi)
 }
 
-/// The BSDF of either model. Twin of WGSL `eval_material`.
+/// Whether the model has a non-delta lobe. Twin of WGSL `has_continuous_metal_rough`.
 #[inline(always)]
-pub fn eval_material(m: &GpuMaterial, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfEval {
-    if m.model == MODEL_METAL_ROUGH {
-        eval(m, s, wo, wi)
-    } else {
-        eval_bsdf(m, Vec3A::from(m.base_color), s, wo, wi)
-    }
-}
-
-/// A direction sampled from either model. Twin of WGSL `sample_material`.
-#[inline(always)]
-pub fn sample_material(
-    m: &GpuMaterial,
-    s: &Surface,
-    wo: Vec3A,
-    u_lobe: f32,
-    u_fresnel: f32,
-    u: Vec2,
-) -> BsdfSample {
-    if m.model == MODEL_METAL_ROUGH {
-        sample(m, s, wo, u_lobe, u_fresnel, u)
-    } else {
-        sample_bsdf(m, Vec3A::from(m.base_color), s, wo, u_lobe, u_fresnel, u)
-    }
-}
-
-/// Whether either model has a non-delta lobe. Twin of WGSL `has_continuous_material_lobe`.
-#[inline(always)]
-pub fn has_continuous_material_lobe(m: &GpuMaterial) -> bool {
-    if m.model == MODEL_METAL_ROUGH {
-        lobes(m).diffuse > 0.0 || m.roughness * m.roughness >= ALPHA_MIN
-    } else {
-        has_continuous_lobe(m)
-    }
+pub fn has_continuous_metal_rough(m: &MetalRoughParams, color: Vec3A) -> bool {
+    lobes(m, color).diffuse > 0.0 || m.roughness * m.roughness >= ALPHA_MIN
 }

@@ -1,11 +1,11 @@
-//! From a hit to the local surface. Twin of `surface.wgsl`.
+//! From a hit to the local surface: position, normals (normal maps applied), texture
+//! coordinates, material. Twin of `surface.wgsl`.
 
 use std::f32::consts::{PI, TAU};
 
 use glam::{Vec2, Vec3A};
 use pathlight_core::gpu_types::{
-    FLAG_CAPS, FLAG_FLAT, GpuMaterial, KIND_CYLINDER, KIND_QUAD, KIND_SPHERE, MODEL_METAL_ROUGH,
-    SLOT_BASE, SLOT_EMISSION, SLOT_METAL_ROUGH, SLOT_NORMAL,
+    FLAG_CAPS, FLAG_FLAT, GpuMaterial, KIND_CYLINDER, KIND_QUAD, KIND_SPHERE, TEXTURE_NORMAL,
 };
 use pathlight_core::octahedral;
 
@@ -13,7 +13,7 @@ use crate::bvh::Hit;
 use crate::cpu_scene::CpuScene;
 use crate::intersect::Ray;
 use crate::sampling::Frame;
-use crate::textures::{sample_slot, srgb_to_linear};
+use crate::textures::{has_texture, material_texture};
 
 /// The surface at a hit. Twin of WGSL `Surface`.
 #[derive(Debug, Clone, Copy)]
@@ -28,41 +28,6 @@ pub struct Surface {
     pub uv: Vec2,
     /// Material index.
     pub material: u32,
-}
-
-/// The material with its textures applied at `uv`. Twin of WGSL `material_at`.
-#[inline(always)]
-pub fn material_at(scene: &CpuScene, material: &GpuMaterial, uv: Vec2) -> GpuMaterial {
-    let mut m = *material;
-    if m.slots[SLOT_BASE].texture >= 0 {
-        let color = srgb_to_linear(
-            sample_slot(scene, &m.slots[SLOT_BASE], uv)
-                .truncate()
-                .into(),
-        );
-        m.base_color = if m.model == MODEL_METAL_ROUGH {
-            (Vec3A::from(m.base_color) * color).into()
-        } else {
-            color.into()
-        };
-    }
-    if m.model != MODEL_METAL_ROUGH {
-        return m;
-    }
-    if m.slots[SLOT_METAL_ROUGH].texture >= 0 {
-        let t = sample_slot(scene, &m.slots[SLOT_METAL_ROUGH], uv);
-        m.roughness *= t.y;
-        m.metallic *= t.z;
-    }
-    if m.slots[SLOT_EMISSION].texture >= 0 {
-        let t = srgb_to_linear(
-            sample_slot(scene, &m.slots[SLOT_EMISSION], uv)
-                .truncate()
-                .into(),
-        );
-        m.emission = (Vec3A::from(m.emission) * t).into();
-    }
-    m
 }
 
 /// The shading normal bent by the material's normal map. Twin of WGSL `normal_mapped`.
@@ -80,7 +45,7 @@ fn normal_mapped(
     }
     let tn = t.normalize();
     let b = ns.cross(tn) * sign;
-    let c = Vec3A::from(sample_slot(scene, &m.slots[SLOT_NORMAL], uv).truncate()) * 2.0 - 1.0;
+    let c = Vec3A::from(material_texture(scene, m, TEXTURE_NORMAL, uv).truncate()) * 2.0 - 1.0;
     let n = tn * (c.x * m.normal_scale) + b * (c.y * m.normal_scale) + ns * c.z;
     if n.dot(n) < 1e-12 {
         return ns;
@@ -89,13 +54,13 @@ fn normal_mapped(
 }
 
 /// Twin of WGSL `surface_at`, except that sphere and cylinder texture coordinates (`atan2`,
-/// `acos`) are computed only for textured materials, the only ones that read them (zero
-/// otherwise).
+/// `acos`) are computed only for materials with a texture, the only ones that read them
+/// (zero otherwise).
 #[inline(always)]
 pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
     let scene = cpu_scene;
     let o = &scene.objects[hit.object as usize];
-    let textured = scene.materials[o.material as usize].slots[SLOT_BASE].texture >= 0;
+    let textured = scene.materials[o.material as usize].texture_mask != 0;
     let [a, b] = [o.a, o.b].map(|v| Vec3A::from_slice(&v));
     let p = Vec3A::from(ray.origin) + hit.t * Vec3A::from(ray.dir);
     let mut s = Surface {
@@ -162,7 +127,7 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
                 s.ns = n.normalize();
             }
             let m = &scene.materials[o.material as usize];
-            if m.model == MODEL_METAL_ROUGH && m.slots[SLOT_NORMAL].texture >= 0 {
+            if has_texture(m, TEXTURE_NORMAL) {
                 let tangent = b0 * decode(v0.tangent)
                     + hit.b1 * decode(v1.tangent)
                     + hit.b2 * decode(v2.tangent);

@@ -3,7 +3,7 @@
 
 use glam::{Vec2, Vec3A, Vec4};
 use pathlight_core::gpu_types::{
-    GpuTextureInfo, GpuTextureSlot, MATERIAL_MASK, SLOT_BASE, WRAP_CLAMP, WRAP_MIRROR, WRAP_REPEAT,
+    GpuMaterial, GpuTextureSlot, MATERIAL_MASK, TEXTURE_BASE, WRAP_CLAMP, WRAP_MIRROR, WRAP_REPEAT,
 };
 
 use crate::cpu_scene::CpuScene;
@@ -20,8 +20,8 @@ pub fn srgb_to_linear(c: Vec3A) -> Vec3A {
 }
 
 /// Twin of WGSL `texel`.
-fn texel(scene: &CpuScene, info: &GpuTextureInfo, x: u32, y: u32) -> Vec4 {
-    let packed = scene.texels[(info.offset + y * info.width + x) as usize];
+fn texel(scene: &CpuScene, slot: &GpuTextureSlot, x: u32, y: u32) -> Vec4 {
+    let packed = scene.texels[(slot.offset + y * slot.width + x) as usize];
     Vec4::from_array(packed.to_le_bytes().map(f32::from)) / 255.0
 }
 
@@ -49,7 +49,7 @@ fn texel_index(i: f32, n: u32, mode: u32) -> u32 {
 /// Bilinear RGBA lookup as stored (sRGB not decoded); row 0 is v = 0. Twin of WGSL
 /// `sample_slot`.
 pub fn sample_slot(scene: &CpuScene, slot: &GpuTextureSlot, uv: Vec2) -> Vec4 {
-    let info = &scene.textures[slot.texture as usize];
+    let info = slot;
     let (mode_u, mode_v) = (slot.wrap & 3, (slot.wrap >> 2) & 3);
     let t = Vec2::new(
         slot.u[0] * uv.x + slot.u[1] * uv.y + slot.u[2],
@@ -66,6 +66,23 @@ pub fn sample_slot(scene: &CpuScene, slot: &GpuTextureSlot, uv: Vec2) -> Vec4 {
     let top = texel(scene, info, x0, y0).lerp(texel(scene, info, x1, y0), f.x);
     let bottom = texel(scene, info, x0, y1).lerp(texel(scene, info, x1, y1), f.x);
     top.lerp(bottom, f.y)
+}
+
+/// Whether material `m` has its texture `which` (a `TEXTURE_*`). Twin of WGSL `has_texture`.
+#[inline(always)]
+pub fn has_texture(m: &GpuMaterial, which: u32) -> bool {
+    (m.texture_mask >> which) & 1 != 0
+}
+
+/// Material `m`'s texture `which` (a `TEXTURE_*` it has) at `uv`. Twin of WGSL
+/// `material_texture`.
+#[inline(always)]
+pub fn material_texture(scene: &CpuScene, m: &GpuMaterial, which: u32, uv: Vec2) -> Vec4 {
+    sample_slot(
+        scene,
+        &scene.texture_slots[(m.textures + which) as usize],
+        uv,
+    )
 }
 
 /// Texture coordinates at barycentrics (b1, b2) of `triangle`. Twin of WGSL `triangle_uv`.
@@ -91,9 +108,9 @@ fn blend_threshold(triangle: u32, t: f32) -> f32 {
 pub fn alpha_stops(scene: &CpuScene, object: u32, triangle: u32, b1: f32, b2: f32, t: f32) -> bool {
     let m = &scene.materials[scene.objects[object as usize].material as usize];
     let mut alpha = m.alpha_factor;
-    if m.slots[SLOT_BASE].texture >= 0 {
+    if has_texture(m, TEXTURE_BASE) {
         let uv = triangle_uv(scene, triangle, b1, b2);
-        alpha *= sample_slot(scene, &m.slots[SLOT_BASE], uv).w;
+        alpha *= material_texture(scene, m, TEXTURE_BASE, uv).w;
     }
     if m.flags & MATERIAL_MASK != 0 {
         alpha >= m.alpha_cutoff

@@ -5,126 +5,142 @@
 
 use std::f32::consts::PI;
 
-use glam::{Vec2, Vec3A};
-use pathlight_core::gpu_types::{
-    GpuMaterial, GpuTextureSlot, MATERIAL_THIN, MODEL_LOBES, MODEL_METAL_ROUGH,
-};
-use pathlight_cpu::bsdf::{fresnel_conductor, fresnel_dielectric, ggx_d};
-use pathlight_cpu::metal_rough::{eval_material, sample_material};
+use glam::{Vec2, Vec3, Vec3A, Vec4};
+use pathlight_core::Textures;
+use pathlight_core::materials::PackedMaterials;
+use pathlight_cpu::material::{MaterialPoint, eval_material, sample_material};
+use pathlight_cpu::microfacet::{BsdfSample, fresnel_conductor, fresnel_dielectric, ggx_d};
 use pathlight_cpu::sampling::sample_uniform_sphere;
 use pathlight_cpu::surface::Surface;
+use pathlight_scene::{Conductor, Lobes, Material, MetalRough, Model};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
 const N: usize = 200_000;
 
-fn material(
+/// A material of `color` and `model` as the BSDF sees it at a point: packed by the host
+/// (`pathlight_core::materials`), its block decoded by the model's kernel.
+fn point(color: [f32; 3], model: Model) -> MaterialPoint {
+    let material = Material::new("m", Vec3::from(color), model);
+    let packed = PackedMaterials::build(&[material], &Textures::build(&[]));
+    let gpu = packed.materials[0];
+    MaterialPoint {
+        model: gpu.model,
+        base_color: Vec3A::from(gpu.base_color),
+        emission: Vec3A::ZERO,
+        params: std::array::from_fn(|i| Vec4::from_array(packed.params[gpu.params as usize + i])),
+    }
+}
+
+/// The seed's lobes on a white base: weights and roughnesses, and gold's conductor Fresnel.
+fn lobes(
     specular: f32,
     spec_rough: f32,
     refract: f32,
     refract_rough: f32,
     conductor: bool,
-) -> GpuMaterial {
-    GpuMaterial {
-        base_color: [1.0; 3],
-        model: MODEL_LOBES,
-        emission: [0.0; 3],
+) -> Model {
+    Model::Lobes(Lobes {
         specular_rate: specular,
-        eta: [0.143_036, 0.375_307, 1.442_05],
-        specular_tint: 0.0,
-        k: [3.983, 2.385_56, 1.603_36],
         specular_roughness: spec_rough,
         refract_rate: refract,
-        refract_tint: 0.0,
-        ior: 1.5,
         refract_roughness: refract_rough,
-        conductor: u32::from(conductor),
-        metallic: 0.0,
-        roughness: 0.0,
-        transmission: 0.0,
-        normal_scale: 1.0,
-        alpha_cutoff: 0.0,
-        alpha_factor: 1.0,
-        flags: 0,
-        slots: [GpuTextureSlot::NONE; 4],
-    }
+        conductor: conductor.then_some(Conductor::GOLD),
+        ..Lobes::DIFFUSE
+    })
 }
 
-/// glTF's metal-rough model: base colour, metallic, roughness, transmission (thin wall or
-/// solid).
-fn metal_rough(
-    color: [f32; 3],
-    metallic: f32,
-    roughness: f32,
-    transmission: f32,
-    thin: bool,
-) -> GpuMaterial {
-    GpuMaterial {
-        base_color: color,
-        model: MODEL_METAL_ROUGH,
+/// glTF's metal-rough model: metallic, roughness, transmission (thin wall or solid).
+fn metal_rough(metallic: f32, roughness: f32, transmission: f32, thin: bool) -> Model {
+    Model::MetalRough(MetalRough {
         metallic,
         roughness,
         transmission,
-        flags: if thin { MATERIAL_THIN } else { 0 },
-        ..material(0.0, 0.0, 0.0, 0.0, false)
-    }
+        thin,
+        ..MetalRough::DEFAULT
+    })
 }
 
-fn cases() -> Vec<(&'static str, GpuMaterial)> {
+/// Every case: a name, a base colour and a model.
+fn cases() -> Vec<(&'static str, [f32; 3], Model)> {
+    let white = [1.0; 3];
     vec![
-        ("lambert", material(0.0, 0.0, 0.0, 0.0, false)),
-        ("rough white mirror", material(1.0, 0.5, 0.0, 0.0, false)),
-        ("rough gold", material(1.0, 0.4, 0.0, 0.0, true)),
-        ("glossy plastic", material(0.3, 0.3, 0.0, 0.0, false)),
-        ("rough glass", material(0.0, 0.0, 1.0, 0.5, false)),
+        ("lambert", white, lobes(0.0, 0.0, 0.0, 0.0, false)),
+        (
+            "rough white mirror",
+            white,
+            lobes(1.0, 0.5, 0.0, 0.0, false),
+        ),
+        ("rough gold", white, lobes(1.0, 0.4, 0.0, 0.0, true)),
+        ("glossy plastic", white, lobes(0.3, 0.3, 0.0, 0.0, false)),
+        ("rough glass", white, lobes(0.0, 0.0, 1.0, 0.5, false)),
         // Alpha 0.1: the roughness at which microfacet samples most often leave on the
         // other lobe's side (issue 16 measured its bias at grazing angles).
-        ("glossy glass", material(0.0, 0.0, 1.0, 0.316, false)),
+        ("glossy glass", white, lobes(0.0, 0.0, 1.0, 0.316, false)),
         (
             "smooth mirror over diffuse",
-            material(0.5, 0.0, 0.0, 0.0, false),
+            white,
+            lobes(0.5, 0.0, 0.0, 0.0, false),
         ),
         (
             "rough glass over diffuse",
-            material(0.0, 0.0, 0.6, 0.3, false),
+            white,
+            lobes(0.0, 0.0, 0.6, 0.3, false),
         ),
         (
             "metal-rough white dielectric, rough",
-            metal_rough([1.0; 3], 0.0, 1.0, 0.0, true),
+            white,
+            metal_rough(0.0, 1.0, 0.0, true),
         ),
         (
             "metal-rough white dielectric, glossy",
-            metal_rough([1.0; 3], 0.0, 0.3, 0.0, true),
+            white,
+            metal_rough(0.0, 0.3, 0.0, true),
         ),
         (
             "metal-rough smooth dielectric",
-            metal_rough([1.0; 3], 0.0, 0.0, 0.0, true),
+            white,
+            metal_rough(0.0, 0.0, 0.0, true),
         ),
         (
             "metal-rough coloured metal",
-            metal_rough([0.9, 0.6, 0.2], 1.0, 0.5, 0.0, true),
+            [0.9, 0.6, 0.2],
+            metal_rough(1.0, 0.5, 0.0, true),
         ),
         (
             "metal-rough half metal",
-            metal_rough([0.5, 0.8, 1.0], 0.5, 0.2, 0.0, true),
+            [0.5, 0.8, 1.0],
+            metal_rough(0.5, 0.2, 0.0, true),
         ),
         (
             "metal-rough thin rough wall",
-            metal_rough([1.0; 3], 0.0, 0.4, 1.0, true),
+            white,
+            metal_rough(0.0, 0.4, 1.0, true),
         ),
         (
             "metal-rough thin smooth wall",
-            metal_rough([0.8, 1.0, 0.9], 0.0, 0.0, 0.7, true),
+            [0.8, 1.0, 0.9],
+            metal_rough(0.0, 0.0, 0.7, true),
         ),
         (
             "metal-rough solid rough glass",
-            metal_rough([1.0; 3], 0.0, 0.5, 1.0, false),
+            white,
+            metal_rough(0.0, 0.5, 1.0, false),
         ),
         (
             "metal-rough solid smooth glass",
-            metal_rough([1.0; 3], 0.0, 0.0, 0.6, false),
+            white,
+            metal_rough(0.0, 0.0, 0.6, false),
         ),
     ]
+}
+
+/// Whether the model refracts into a solid (radiance scaled by 1/eta^2 going in).
+fn solid(model: &Model) -> bool {
+    match model {
+        Model::Lobes(l) => l.refract_rate > 0.0,
+        Model::MetalRough(m) => m.transmission > 0.0 && !m.thin,
+    }
 }
 
 /// Mean of `values` and its standard error.
@@ -158,7 +174,7 @@ fn outgoing() -> Vec<Vec3A> {
     ]
 }
 
-fn sample(rng: &mut StdRng, m: &GpuMaterial, wo: Vec3A) -> pathlight_cpu::bsdf::BsdfSample {
+fn sample(rng: &mut StdRng, m: &MaterialPoint, wo: Vec3A) -> BsdfSample {
     let u = Vec2::new(rng.random(), rng.random());
     sample_material(m, &surface(), wo, rng.random(), rng.random(), u)
 }
@@ -166,7 +182,8 @@ fn sample(rng: &mut StdRng, m: &GpuMaterial, wo: Vec3A) -> pathlight_cpu::bsdf::
 #[test]
 fn samples_agree_with_eval_and_pdf() {
     let mut rng = StdRng::seed_from_u64(1);
-    for (name, m) in cases() {
+    for (name, color, model) in cases() {
+        let m = point(color, model);
         for wo in outgoing() {
             for _ in 0..2000 {
                 let bs = sample(&mut rng, &m, wo);
@@ -194,7 +211,8 @@ fn samples_agree_with_eval_and_pdf() {
 #[test]
 fn densities_integrate_to_the_non_delta_probability() {
     let mut rng = StdRng::seed_from_u64(2);
-    for (name, m) in cases() {
+    for (name, color, model) in cases() {
+        let m = point(color, model);
         for wo in outgoing() {
             // Integral of the density over the sphere, by uniform sampling.
             let integrals: Vec<f64> = (0..N)
@@ -227,7 +245,8 @@ fn densities_integrate_to_the_non_delta_probability() {
 #[test]
 fn sampled_albedo_equals_the_integral_of_eval() {
     let mut rng = StdRng::seed_from_u64(5);
-    for (name, m) in cases() {
+    for (name, color, model) in cases() {
+        let m = point(color, model);
         if name.contains("smooth") {
             continue;
         }
@@ -262,7 +281,8 @@ fn sampled_albedo_equals_the_integral_of_eval() {
 #[test]
 fn no_material_creates_energy() {
     let mut rng = StdRng::seed_from_u64(3);
-    for (name, m) in cases() {
+    for (name, color, model) in cases() {
+        let m = point(color, model);
         for wo in outgoing() {
             let weights: Vec<f64> = (0..N)
                 .map(|_| {
@@ -276,11 +296,11 @@ fn no_material_creates_energy() {
                 .collect();
             let (mean, error) = mean_and_error(&weights);
             // Refraction scales radiance by 1/eta^2 going in and eta^2 coming out.
-            let solid = m.refract_rate > 0.0
-                || (m.model == MODEL_METAL_ROUGH
-                    && m.transmission > 0.0
-                    && m.flags & MATERIAL_THIN == 0);
-            let bound = if wo.z < 0.0 && solid { 2.25 } else { 1.0 };
+            let bound = if wo.z < 0.0 && solid(&model) {
+                2.25
+            } else {
+                1.0
+            };
             assert!(
                 mean <= bound + 5.0 * error + 1e-4,
                 "{name}, wo {wo}: albedo {mean}"
@@ -346,7 +366,7 @@ fn metal_rough_never_gains_energy() {
     for roughness in [0.0, 0.05, 0.2, 0.5, 0.8, 1.0] {
         for metallic in [0.0, 0.5, 1.0] {
             for color in [[1.0; 3], [0.9, 0.4, 0.1]] {
-                let m = metal_rough(color, metallic, roughness, 0.0, true);
+                let m = point(color, metal_rough(metallic, roughness, 0.0, true));
                 for wo in outgoing().into_iter().filter(|w| w.z > 0.0) {
                     let weights: Vec<f64> = (0..N / 10)
                         .map(|_| {
@@ -374,7 +394,7 @@ fn metal_rough_never_gains_energy() {
 #[test]
 fn metallic_one_is_a_schlick_conductor() {
     let f0 = Vec3A::new(0.95, 0.64, 0.54);
-    let m = metal_rough(f0.to_array(), 1.0, 0.6, 0.0, true);
+    let m = point(f0.to_array(), metal_rough(1.0, 0.6, 0.0, true));
     let alpha = 0.36f32;
     let wo = Vec3A::new(0.6, 0.0, 0.8);
     let wi = Vec3A::new(-0.3, 0.4, 0.866).normalize();
@@ -391,7 +411,7 @@ fn metallic_one_is_a_schlick_conductor() {
         "{} vs {expected}",
         e.f
     );
-    let smooth = metal_rough(f0.to_array(), 1.0, 0.0, 0.0, true);
+    let smooth = point(f0.to_array(), metal_rough(1.0, 0.0, 0.0, true));
     let mut rng = StdRng::seed_from_u64(8);
     let bs = sample(&mut rng, &smooth, wo);
     assert!(bs.delta && bs.valid);

@@ -6,7 +6,7 @@
 //!
 //! Measured over seeds 0-7 (2026-11-22): cornell-diffuse means within 0.06%, relMSE
 //! 0.34-0.39x Mitsuba's; cornell-spheres means within 0.23%, relMSE 0.92-1.02x. The GPU
-//! runs the same estimator (see crates/render/tests/gpu/twin.rs).
+//! runs the same estimator (see crates/gpu/tests/gpu/twin.rs).
 
 use std::path::{Path, PathBuf};
 

@@ -16,7 +16,7 @@ fn cpu_src() -> PathBuf {
 }
 
 fn shaders() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../render/shaders")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../gpu/shaders")
 }
 
 /// The identifiers quoted right after `marker` in `text` (as in ``Twin of WGSL `x` ``).
@@ -163,28 +163,60 @@ fn every_twin_claim_is_named_back_and_every_mark_is_claimed() {
     );
 }
 
+/// The leading comment block of a file: its header.
+fn header(text: &str, comment: &str) -> String {
+    text.lines()
+        .take_while(|line| line.starts_with(comment))
+        .map(|line| line[comment.len()..].trim())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Every WGSL file either names its twin file in its header (``CPU twin:
+/// `crates/cpu/src/X.rs` ``), which exists and claims it back (``Twin of `X.wgsl` `` in its
+/// module doc), or says why it has none in a marked header line (`No CPU twin: ...`, as
+/// `scene.wgsl`, which only declares); and every CPU file that claims a WGSL twin has it.
+/// Both folders are read, so a new file cannot be forgotten.
 #[test]
-fn every_integrator_file_has_its_twin_file() {
-    for stem in [
-        "intersect",
-        "bvh",
-        "sampler",
-        "sampling",
-        "camera",
-        "surface",
-        "bsdf",
-        "lights",
-        "integrator",
-        "display",
-    ] {
-        assert!(
-            shaders().join(format!("{stem}.wgsl")).is_file(),
-            "{stem}.wgsl"
-        );
-        assert!(
-            cpu_src().join(format!("{stem}.rs")).is_file(),
-            "src/{stem}.rs"
-        );
+fn every_wgsl_file_has_its_twin_file_or_says_why_not() {
+    let mut twinned = BTreeSet::new();
+    for entry in std::fs::read_dir(shaders()).unwrap() {
+        let path = entry.unwrap().path();
+        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let head = header(&std::fs::read_to_string(&path).unwrap(), "//");
+        let twin = format!("CPU twin: `crates/cpu/src/{stem}.rs`");
+        match (head.contains(&twin), head.contains("No CPU twin:")) {
+            (true, false) => {
+                let rust = cpu_src().join(format!("{stem}.rs"));
+                let doc = std::fs::read_to_string(&rust)
+                    .map(|text| header(&text, "//!"))
+                    .unwrap_or_else(|_| {
+                        panic!("shaders/{stem}.wgsl names src/{stem}.rs, which does not exist")
+                    });
+                assert!(
+                    doc.contains(&format!("`{stem}.wgsl`"))
+                        && doc.to_lowercase().contains("twin of"),
+                    "src/{stem}.rs does not say it is the twin of `{stem}.wgsl` in its module doc"
+                );
+                twinned.insert(stem);
+            }
+            (false, true) => {}
+            _ => panic!(
+                "shaders/{stem}.wgsl: its header must name its twin ({twin}) or say `No CPU twin:` and why, not both"
+            ),
+        }
+    }
+    assert!(twinned.len() >= 15, "only {} twinned files", twinned.len());
+    for entry in std::fs::read_dir(cpu_src()).unwrap() {
+        let path = entry.unwrap().path();
+        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let doc = header(&std::fs::read_to_string(&path).unwrap(), "//!");
+        if doc.contains(&format!("`{stem}.wgsl`")) {
+            assert!(
+                twinned.contains(&stem),
+                "src/{stem}.rs claims `{stem}.wgsl`, which does not name it as its twin"
+            );
+        }
     }
 }
 

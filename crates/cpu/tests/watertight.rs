@@ -2,7 +2,7 @@
 //! vertices that triangles share (where a test that rounds each triangle on its own lets a
 //! ray slip through) hit the mesh no farther than the point aimed at. A torus, an
 //! icosphere and the default scene's vase, from every direction; 10^7 rays in all, through
-//! the CPU's single-ray walk. (The GPU's walk: `crates/render/tests/gpu/trace.rs`.)
+//! the CPU's single-ray walk. (The GPU's walk: `crates/gpu/tests/gpu/trace.rs`.)
 
 use pathlight_core::PreparedScene;
 use pathlight_cpu::intersect::Ray;

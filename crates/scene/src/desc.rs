@@ -158,50 +158,76 @@ pub struct EnvironmentDesc {
     pub rotation: Option<f32>,
 }
 
-/// A material: the seed's parameters plus emission and conductors.
+/// A material: the keys every model shares (colour, texture, emission), `model`, and the
+/// keys of each model (the loader refuses another model's keys).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialDesc {
+    /// The material model; the seed's lobes when absent.
+    pub model: Option<ModelDesc>,
     /// Base colour, in the file's `color_space`.
     #[serde(default = "default_color", deserialize_with = "exact::array")]
     pub color: [f32; 3],
-    /// Image (PNG/JPEG, sRGB) replacing `color`, path relative to the scene file.
+    /// Image (PNG/JPEG, sRGB), path relative to the scene file: it replaces `color` under the
+    /// lobes and multiplies it under the metal-rough model.
     pub texture: Option<String>,
     /// Emitted linear radiance (W m^-2 sr^-1), on the front side only.
     #[serde(default, deserialize_with = "exact::optional_array")]
     pub emission: Option<[f32; 3]>,
-    /// One of the seed's materials (`metal`, `plastic`, `wall`, `glass`, `wood`, `ceramic`)
+    /// Lobes: one of the seed's materials (`metal`, `plastic`, `wall`, `glass`, `wood`, `ceramic`)
     /// giving defaults for the lobe parameters below.
     pub preset: Option<String>,
-    /// Weight of the specular reflection lobe.
+    /// Lobes: weight of the specular reflection lobe.
     pub specular_rate: Option<f32>,
-    /// Specular colour between white (0) and the base colour (1).
+    /// Lobes: specular colour between white (0) and the base colour (1).
     pub specular_tint: Option<f32>,
-    /// Roughness of the specular lobe (GGX alpha = roughness^2).
+    /// Lobes: roughness of the specular lobe (GGX alpha = roughness^2).
     pub specular_roughness: Option<f32>,
-    /// Weight of the transmission lobe.
+    /// Lobes: weight of the transmission lobe.
     pub refract_rate: Option<f32>,
-    /// Transmitted colour between white (0) and the base colour (1).
+    /// Lobes: transmitted colour between white (0) and the base colour (1).
     pub refract_tint: Option<f32>,
-    /// Index of refraction of the inside.
+    /// Both models: index of refraction of the inside (lobes: of the transmission lobe;
+    /// metal-rough: of the dielectric).
     pub ior: Option<f32>,
-    /// Roughness of transmission (GGX alpha = roughness^2).
+    /// Lobes: roughness of transmission (GGX alpha = roughness^2).
     pub refract_roughness: Option<f32>,
-    /// Conductor Fresnel for the specular lobe: a preset name (`"gold"`, `"aluminium"`, ...).
+    /// Lobes: conductor Fresnel for the specular lobe: a preset name (`"gold"`, `"aluminium"`, ...).
     pub conductor: Option<String>,
-    /// Conductor Fresnel from a complex index of refraction: real part per RGB channel.
+    /// Lobes: conductor Fresnel from a complex index of refraction: real part per RGB channel.
     #[serde(default, deserialize_with = "exact::optional_array")]
     pub eta: Option<[f32; 3]>,
-    /// Conductor Fresnel from a complex index of refraction: imaginary part per RGB channel.
+    /// Lobes: conductor Fresnel from a complex index of refraction: imaginary part per RGB channel.
     #[serde(default, deserialize_with = "exact::optional_array")]
     pub k: Option<[f32; 3]>,
-    /// glTF's metal-rough model instead of the lobes: 0 dielectric, 1 metal.
+    /// Metal-rough: 0 dielectric, 1 metal.
     pub metallic: Option<f32>,
-    /// glTF's metal-rough model: perceptual roughness (GGX alpha = roughness^2).
+    /// Metal-rough: perceptual roughness (GGX alpha = roughness^2).
     pub roughness: Option<f32>,
-    /// glTF's metal-rough model: fraction of the dielectric base that transmits, through a
+    /// Metal-rough: fraction of the dielectric base that transmits, through a
     /// thin wall (`KHR_materials_transmission`).
     pub transmission: Option<f32>,
+}
+
+/// A material model, as `model = "..."` names it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+pub enum ModelDesc {
+    /// The seed's lobe mixture.
+    #[serde(rename = "lobes")]
+    Lobes,
+    /// glTF's metallic-roughness model.
+    #[serde(rename = "metal-rough")]
+    MetalRough,
+}
+
+impl ModelDesc {
+    /// Its name in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Lobes => "lobes",
+            Self::MetalRough => "metal-rough",
+        }
+    }
 }
 
 fn default_color() -> [f32; 3] {

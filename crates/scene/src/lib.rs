@@ -25,7 +25,7 @@ pub use environment::{Environment, EnvironmentMap, HdrImage};
 pub use error::{RangeError, SceneError};
 pub use gltf_file::{GltfModel, gltf_scene, load_gltf};
 pub use load::{SceneSource, load_scene, load_scene_file};
-pub use material::{AlphaMode, Conductor, Lobes, Material, MetalRough, TextureRef, Wrap};
+pub use material::{AlphaMode, Conductor, Lobes, Material, MetalRough, Model, TextureRef, Wrap};
 pub use settings::{RenderSettings, Sampler};
 pub use shape::{Object, Shape, TriangleMesh};
 pub use texture::Texture;

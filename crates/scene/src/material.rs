@@ -1,4 +1,6 @@
-//! Materials: the seed's lobe parameters in linear RGB, and conductor presets.
+//! Materials: a common part (base colour, emission, their textures, a normal map, alpha)
+//! and a material model, in linear RGB: the seed's lobe mixture ([`Lobes`], with conductor
+//! presets) or glTF's metallic-roughness model ([`MetalRough`]).
 
 use glam::Vec3;
 
@@ -53,6 +55,8 @@ pub struct Lobes {
     pub ior: f32,
     /// Roughness of transmission.
     pub refract_roughness: f32,
+    /// Complex-IOR Fresnel for the specular lobe, else Schlick from the specular colour.
+    pub conductor: Option<Conductor>,
 }
 
 impl Lobes {
@@ -65,6 +69,7 @@ impl Lobes {
         refract_tint: 0.0,
         ior: 1.5,
         refract_roughness: 0.0,
+        conductor: None,
     };
 
     /// The seed's six materials: lobe parameters chosen to look like the real thing.
@@ -127,23 +132,83 @@ impl Lobes {
     }
 }
 
-/// A material in linear RGB with the seed's lobe weights.
+/// A material in linear RGB: what every model shares, and its model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Material {
     /// Name in the scene file.
     pub name: String,
-    /// Linear base colour (used when there is no texture).
+    /// Linear base colour, multiplied by `texture` where there is one.
     pub base_color: Vec3,
-    /// The texture replacing the base colour (glTF: multiplying it).
+    /// The base colour texture (sRGB; its alpha channel is the material's alpha).
     pub texture: Option<TextureRef>,
-    /// Emitted radiance on the front side.
+    /// Emitted radiance on the front side, multiplied by `emission_texture`.
     pub emission: Vec3,
-    /// Lobe weights and parameters.
-    pub lobes: Lobes,
-    /// Complex-IOR Fresnel for the specular lobe, else Schlick from the specular colour.
-    pub conductor: Option<Conductor>,
-    /// The glTF metal-rough model, which then replaces `lobes` and `conductor`.
-    pub metal_rough: Option<MetalRough>,
+    /// The emission texture (sRGB).
+    pub emission_texture: Option<TextureRef>,
+    /// Tangent-space normal map (linear, MikkTSpace), on meshes with tangents.
+    pub normal_texture: Option<TextureRef>,
+    /// Scales the normal map's x and y.
+    pub normal_scale: f32,
+    /// Use of alpha.
+    pub alpha: AlphaMode,
+    /// Base colour alpha factor.
+    pub alpha_factor: f32,
+    /// How the surface scatters light.
+    pub model: Model,
+}
+
+impl Material {
+    /// An opaque, untextured, non-emissive material of `model`.
+    pub fn new(name: impl Into<String>, base_color: Vec3, model: Model) -> Self {
+        Self {
+            name: name.into(),
+            base_color,
+            texture: None,
+            emission: Vec3::ZERO,
+            emission_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
+            alpha: AlphaMode::Opaque,
+            alpha_factor: 1.0,
+            model,
+        }
+    }
+
+    /// Every texture the material reads, its own and its model's.
+    pub fn textures_mut(&mut self) -> impl Iterator<Item = &mut TextureRef> {
+        let model = match &mut self.model {
+            Model::Lobes(_) => None,
+            Model::MetalRough(pbr) => pbr.metal_rough_texture.as_mut(),
+        };
+        [
+            self.texture.as_mut(),
+            self.emission_texture.as_mut(),
+            self.normal_texture.as_mut(),
+            model,
+        ]
+        .into_iter()
+        .flatten()
+    }
+}
+
+/// A material model: how a surface scatters light. The kernels hold one BSDF per model
+/// (ARCHITECTURE.md, "How to add a material model").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Model {
+    /// The seed's mixture of Lambert, specular and transmission lobes.
+    Lobes(Lobes),
+    /// glTF 2.0's metallic-roughness model.
+    MetalRough(MetalRough),
+}
+
+impl Model {
+    /// Its name in scene files (`model = "..."`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Lobes(_) => "lobes",
+            Self::MetalRough(_) => "metal-rough",
+        }
+    }
 }
 
 /// How a texture's coordinates wrap outside [0, 1] (glTF's sampler modes).
@@ -194,9 +259,9 @@ pub enum AlphaMode {
     Blend,
 }
 
-/// glTF 2.0's metallic-roughness material (with the `KHR_materials_ior`, `_transmission`,
-/// `_volume` and `_emissive_strength` extensions). The base colour, its texture and the
-/// emission are [`Material`]'s own fields.
+/// glTF 2.0's metallic-roughness model (with the `KHR_materials_ior`, `_transmission` and
+/// `_volume` extensions). The base colour, its texture, the emission, the normal map and
+/// alpha are [`Material`]'s own.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MetalRough {
     /// 0 dielectric, 1 metal.
@@ -205,38 +270,23 @@ pub struct MetalRough {
     pub roughness: f32,
     /// Multiplies metallic by its blue channel and roughness by its green (linear).
     pub metal_rough_texture: Option<TextureRef>,
-    /// Tangent-space normal map (linear, MikkTSpace).
-    pub normal_texture: Option<TextureRef>,
-    /// Scales the normal map's x and y.
-    pub normal_scale: f32,
-    /// Multiplies the emission (sRGB).
-    pub emission_texture: Option<TextureRef>,
     /// Index of refraction of the dielectric (1.5 unless `KHR_materials_ior`).
     pub ior: f32,
     /// Fraction of the dielectric base that transmits instead of scattering diffusely.
     pub transmission: f32,
     /// Transmission through a thin wall (no volume): rays leave undeviated by refraction.
     pub thin: bool,
-    /// Use of alpha.
-    pub alpha: AlphaMode,
-    /// Base colour alpha factor.
-    pub alpha_factor: f32,
 }
 
 impl MetalRough {
-    /// A white-based, fully rough dielectric with no textures (glTF's defaults but for
-    /// metallic, which glTF defaults to 1).
+    /// A fully rough dielectric with no texture (glTF's defaults but for metallic, which
+    /// glTF defaults to 1).
     pub const DEFAULT: Self = Self {
         metallic: 0.0,
         roughness: 1.0,
         metal_rough_texture: None,
-        normal_texture: None,
-        normal_scale: 1.0,
-        emission_texture: None,
         ior: 1.5,
         transmission: 0.0,
         thin: true,
-        alpha: AlphaMode::Opaque,
-        alpha_factor: 1.0,
     };
 }

@@ -6,7 +6,7 @@ use rand::Rng;
 use rand::rngs::StdRng;
 
 use crate::{
-    Camera, Environment, Lobes, Material, Object, RenderSettings, Sampler, Scene, Shape,
+    Camera, Environment, Lobes, Material, Model, Object, RenderSettings, Sampler, Scene, Shape,
     TriangleMesh,
 };
 
@@ -32,15 +32,11 @@ pub fn scene_of(objects: Vec<Object>) -> Scene {
             sampler: Sampler::Sobol,
         },
         environment: Environment::default(),
-        materials: vec![Material {
-            name: "grey".into(),
-            base_color: Vec3::splat(0.5),
-            texture: None,
-            emission: Vec3::ZERO,
-            lobes: Lobes::DIFFUSE,
-            conductor: None,
-            metal_rough: None,
-        }],
+        materials: vec![Material::new(
+            "grey",
+            Vec3::splat(0.5),
+            Model::Lobes(Lobes::DIFFUSE),
+        )],
         textures: Vec::new(),
         objects,
     }

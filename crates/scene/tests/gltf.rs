@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use base64::Engine;
 use glam::{Mat4, Quat, Vec3};
 use pathlight_scene::{
-    AlphaMode, Environment, Scene, SceneSource, Shape, TriangleMesh, gltf_scene, load_gltf,
+    AlphaMode, Environment, Model, Scene, SceneSource, Shape, TriangleMesh, gltf_scene, load_gltf,
     load_scene,
 };
 
@@ -304,10 +304,8 @@ fn texture_transforms_and_samplers_are_read() {
     }
     // The file's sampler clamps both axes.
     assert_eq!(rotated.wrap, [pathlight_scene::Wrap::Clamp; 2]);
-    let pbr = scene.materials[0]
-        .metal_rough
-        .expect("a metal-rough material");
-    assert_eq!(pbr.alpha, AlphaMode::Opaque);
+    assert!(matches!(scene.materials[0].model, Model::MetalRough(_)));
+    assert_eq!(scene.materials[0].alpha, AlphaMode::Opaque);
 }
 
 #[test]
@@ -324,6 +322,7 @@ resolution = [64, 64]
 color = [0.5, 0.5, 0.5]
 
 [materials.shiny]
+model = "metal-rough"
 metallic = 1.0
 roughness = 0.2
 color = [0.9, 0.7, 0.3]
@@ -370,9 +369,9 @@ transform = { translate = [-1, 0, 0], scale = 0.5 }
         });
     assert!(lo.distance(Vec3::new(-1.25, -0.25, -0.25)) < 1e-5, "{lo}");
     assert!(hi.distance(Vec3::new(-0.75, 0.25, 0.25)) < 1e-5, "{hi}");
-    let shiny = scene.materials[1]
-        .metal_rough
-        .expect("metal-rough from the TOML keys");
+    let Model::MetalRough(shiny) = scene.materials[1].model else {
+        panic!("metal-rough from the TOML keys");
+    };
     assert_eq!((shiny.metallic, shiny.roughness), (1.0, 0.2));
     let bad = text.replace("BoxTextured.glb", "absent.glb");
     let err = load_scene(&SceneSource {
@@ -384,7 +383,7 @@ transform = { translate = [-1, 0, 0], scale = 0.5 }
     .unwrap_err()
     .to_string();
     assert!(
-        err.starts_with("mixed.toml:27: gltf.file: cannot read"),
+        err.starts_with("mixed.toml:28: gltf.file: cannot read"),
         "{err}"
     );
 }

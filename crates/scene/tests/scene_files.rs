@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 
 use pathlight_scene::settings::{MAX_RESOLUTION, MAX_SPP};
 use pathlight_scene::{
-    Environment, Scene, SceneError, SceneSource, Shape, default_scene, load_scene, load_scene_file,
+    Environment, Lobes, Model, Scene, SceneError, SceneSource, Shape, default_scene, load_scene,
+    load_scene_file,
 };
 
 fn repo() -> PathBuf {
@@ -178,27 +179,67 @@ fn out_of_range_material_parameters_are_refused() {
     }
 }
 
+/// `model` chooses the material model; without it a material is under the lobes, and a key
+/// of another model is refused saying what to write.
+#[test]
+fn the_model_key_chooses_the_material_model() {
+    let scene = load(
+        "[materials.a]\nmodel = \"metal-rough\"\nmetallic = 1.0\nroughness = 0.2\n[materials.b]\nmodel = \"lobes\"\npreset = \"plastic\"\n[materials.c]\ncolor = [0.5, 0.5, 0.5]\n",
+    )
+    .unwrap();
+    let model = |name: &str| {
+        scene
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .unwrap()
+            .model
+    };
+    let Model::MetalRough(a) = model("a") else {
+        panic!("a is metal-rough")
+    };
+    assert_eq!((a.metallic, a.roughness, a.transmission), (1.0, 0.2, 0.0));
+    assert!(matches!(model("b"), Model::Lobes(l) if l.specular_rate == 0.1));
+    assert_eq!(model("c"), Model::Lobes(Lobes::DIFFUSE));
+    // The metal-rough keys of an older file, without `model`:
+    let message = error("[materials.m]\nmetallic = 1.0\n");
+    assert_eq!(
+        message,
+        "test.toml:6: materials.m.metallic: a key of the \"metal-rough\" model; without `model` \
+         a material is \"lobes\": write model = \"metal-rough\" to use it"
+    );
+    let message = error("[materials.m]\nmodel = \"metal-rough\"\nspecular_rate = 0.5\n");
+    assert!(
+        message.contains("materials.m.specular_rate: a key of the \"lobes\" model; this material's model is \"metal-rough\""),
+        "{message}"
+    );
+    let message = error("[materials.m]\nmodel = \"marble\"\n");
+    assert!(
+        message.starts_with("test.toml:7:") && message.contains("metal-rough"),
+        "{message}"
+    );
+}
+
 #[test]
 fn seed_presets_give_defaults_that_keys_override() {
     let scene = load(
         "[materials.a]\npreset = \"metal\"\n[materials.b]\npreset = \"glass\"\nior = 1.33\n[materials.c]\npreset = \"ceramic\"\nspecular_rate = 0.5\n",
     )
     .unwrap();
-    let m = |name: &str| {
-        scene
-            .materials
-            .iter()
-            .find(|m| m.name == name)
-            .unwrap()
-            .clone()
+    let m = |name: &str| match scene
+        .materials
+        .iter()
+        .find(|m| m.name == name)
+        .unwrap()
+        .model
+    {
+        Model::Lobes(lobes) => lobes,
+        Model::MetalRough(_) => panic!("{name} is not under the lobe model"),
     };
-    assert_eq!(
-        (m("a").lobes.specular_rate, m("a").lobes.specular_tint),
-        (1.0, 1.0)
-    );
-    assert_eq!((m("b").lobes.refract_rate, m("b").lobes.ior), (1.0, 1.33));
-    assert_eq!(m("c").lobes.specular_rate, 0.5);
-    assert!(m("c").lobes.specular_roughness > 0.0);
+    assert_eq!((m("a").specular_rate, m("a").specular_tint), (1.0, 1.0));
+    assert_eq!((m("b").refract_rate, m("b").ior), (1.0, 1.33));
+    assert_eq!(m("c").specular_rate, 0.5);
+    assert!(m("c").specular_roughness > 0.0);
     let message = error("[materials.m]\npreset = \"marble\"\n");
     assert!(
         message.starts_with("test.toml:6:") && message.contains("ceramic"),

@@ -14,7 +14,7 @@ use pathlight_core::gpu_types::GpuAccumPixel;
 use pathlight_core::{Film, RenderError, Renderer, Shading};
 use pathlight_cpu::CpuRenderer;
 use pathlight_cpu::display::{CpuDisplay, DisplayImage};
-use pathlight_render::display::DisplaySource;
+use pathlight_gpu::display::DisplaySource;
 use pathlight_scene::Camera;
 
 use crate::view::frames::{Frames, Rendered, Target, WHOLE_FRAME};

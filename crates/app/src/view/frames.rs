@@ -6,8 +6,8 @@ use std::time::{Duration, Instant};
 
 use pathlight_core::{Film, Renderer, Shading, ToneMap};
 use pathlight_cpu::display::ChannelOrder;
-use pathlight_render::display::{DisplayPass, DisplaySource};
-use pathlight_render::{GpuContext, GpuRenderer};
+use pathlight_gpu::display::{DisplayPass, DisplaySource};
+use pathlight_gpu::{GpuContext, GpuRenderer};
 use pathlight_scene::Camera;
 
 /// Frames finished by one [`Frames::render`] call.

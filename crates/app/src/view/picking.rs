@@ -160,8 +160,8 @@ mod tests {
             lit.emission
         );
         assert_eq!(
-            lit.lobes,
-            own.materials[own.objects[vase].material as usize].lobes
+            lit.model,
+            own.materials[own.objects[vase].material as usize].model
         );
         let prepared = PreparedScene::new(&own).unwrap();
         let lights = |s: &Scene| prepared.shading_of(s).light_count;

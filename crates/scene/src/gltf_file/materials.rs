@@ -8,7 +8,7 @@ use gltf::texture::WrappingMode;
 use super::data::Files;
 use super::primitives::Needs;
 use crate::error::SceneError;
-use crate::material::{AlphaMode, Lobes, Material, MetalRough, TextureRef, Wrap};
+use crate::material::{AlphaMode, Material, MetalRough, Model, TextureRef, Wrap};
 use crate::texture::Texture;
 
 /// A glTF file's materials, converted once each, and the images they decode.
@@ -114,14 +114,9 @@ impl Materials {
             metallic: pbr.metallic_factor(),
             roughness: pbr.roughness_factor(),
             metal_rough_texture,
-            normal_texture,
-            normal_scale,
-            emission_texture,
             ior: material.ior().unwrap_or(1.5),
             transmission: transmission.map_or(0.0, |t| t.transmission_factor()),
             thin: thickness <= 0.0,
-            alpha,
-            alpha_factor,
         };
         let numbers = [
             r,
@@ -154,13 +149,15 @@ impl Materials {
             base_color: Vec3::new(r, g, b).min(Vec3::ONE),
             texture: base_texture,
             emission,
-            lobes: Lobes::DIFFUSE,
-            conductor: None,
-            metal_rough: Some(MetalRough {
+            emission_texture,
+            normal_texture,
+            normal_scale,
+            alpha,
+            alpha_factor: alpha_factor.min(1.0),
+            model: Model::MetalRough(MetalRough {
                 metallic: metal_rough.metallic.min(1.0),
                 roughness: metal_rough.roughness.min(1.0),
                 transmission: metal_rough.transmission.min(1.0),
-                alpha_factor: alpha_factor.min(1.0),
                 ..metal_rough
             }),
         };

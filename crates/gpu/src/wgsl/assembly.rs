@@ -1,4 +1,5 @@
-//! WGSL assembly: the files under `shaders/` joined into modules by their imports.
+//! WGSL assembly: files joined into modules by their imports, whatever holds the files (the
+//! crate's generated table, or `build.rs` reading `shaders/` itself).
 //!
 //! Each file states what it uses on lines of its own, before its declarations:
 //! - `#import NAME` makes the declarations of `shaders/NAME.wgsl` available (its own imports
@@ -11,25 +12,6 @@
 //! time, so a shader error is a build error with its source span.
 
 use std::fmt::Write as _;
-
-/// Every WGSL file of the crate, by the name imports use.
-pub const FILES: [(&str, &str); 15] = [
-    ("scene", include_str!("../shaders/scene.wgsl")),
-    ("textures", include_str!("../shaders/textures.wgsl")),
-    ("intersect", include_str!("../shaders/intersect.wgsl")),
-    ("bvh", include_str!("../shaders/bvh.wgsl")),
-    ("params", include_str!("../shaders/params.wgsl")),
-    ("sampler", include_str!("../shaders/sampler.wgsl")),
-    ("sampling", include_str!("../shaders/sampling.wgsl")),
-    ("camera", include_str!("../shaders/camera.wgsl")),
-    ("surface", include_str!("../shaders/surface.wgsl")),
-    ("bsdf", include_str!("../shaders/bsdf.wgsl")),
-    ("metal_rough", include_str!("../shaders/metal_rough.wgsl")),
-    ("environment", include_str!("../shaders/environment.wgsl")),
-    ("lights", include_str!("../shaders/lights.wgsl")),
-    ("integrator", include_str!("../shaders/integrator.wgsl")),
-    ("display", include_str!("../shaders/display.wgsl")),
-];
 
 /// The modules the renderer compiles: the path tracer (entry point `render`) and the
 /// viewer's display pass.
@@ -84,24 +66,18 @@ impl std::fmt::Display for AssemblyError {
 
 impl std::error::Error for AssemblyError {}
 
-/// The text of file `name`.
-pub fn source(name: &str) -> Option<&'static str> {
-    FILES.iter().find(|(n, _)| *n == name).map(|(_, s)| *s)
-}
-
-/// The module made of file `name` and everything it imports, with the `#const` values
-/// `constants`.
-pub fn assemble(name: &str, constants: &[(&str, u32)]) -> Result<String, AssemblyError> {
-    assemble_source(&format!("#import {name}\n"), constants)
-}
-
-/// The module made of `text` (WGSL with directives, e.g. a test's pass) and everything it
-/// imports, with the `#const` values `constants`.
-pub fn assemble_source(text: &str, constants: &[(&str, u32)]) -> Result<String, AssemblyError> {
+/// The module made of `text` (WGSL with directives) and everything it imports, the text of
+/// each file `name` being `files(name)`, with the `#const` values `constants`.
+pub fn assemble_with(
+    text: &str,
+    files: &dyn Fn(&str) -> Option<&'static str>,
+    constants: &[(&str, u32)],
+) -> Result<String, AssemblyError> {
     let mut assembly = Assembly {
         out: String::new(),
         included: Vec::new(),
         chain: Vec::new(),
+        files,
         constants,
     };
     assembly.include("<source>", text)?;
@@ -115,6 +91,8 @@ struct Assembly<'a> {
     included: Vec<String>,
     /// Files being included, outermost first (to find cycles).
     chain: Vec<String>,
+    /// The text of each file, by name.
+    files: &'a dyn Fn(&str) -> Option<&'static str>,
     /// Values of the `#const`s (others may be given: they are ignored).
     constants: &'a [(&'a str, u32)],
 }
@@ -174,7 +152,7 @@ impl Assembly<'_> {
         if self.included.iter().any(|f| f == name) {
             return Ok(());
         }
-        let text = source(name).ok_or_else(|| AssemblyError::UnknownImport {
+        let text = (self.files)(name).ok_or_else(|| AssemblyError::UnknownImport {
             file: file.to_owned(),
             name: name.to_owned(),
         })?;

@@ -7,6 +7,7 @@
 // (pixel, sample, seed).
 
 const SAMPLER_SOBOL: u32 = 0u;
+const SAMPLER_INDEPENDENT: u32 = 1u;
 
 // PCG hash: Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 2020.
 // CPU twin: `pcg_hash`.

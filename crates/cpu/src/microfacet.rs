@@ -1,24 +1,15 @@
-//! The material model. Twin of `bsdf.wgsl`.
-//!
-//! A mixture of lobes with the seed's weights: Lambert (`1 - specular_rate - refract_rate`),
-//! specular reflection (`specular_rate`) and transmission (`refract_rate`). The specular lobe
-//! is a smooth mirror or a GGX microfacet conductor (Fresnel from a complex IOR, or Schlick
-//! from the specular colour); transmission is a smooth or GGX-rough dielectric (Walter et
-//! al. 2007, in pbrt-v4's formulation) with exact Fresnel. GGX uses Mitsuba 3's separable
-//! Smith term G1(wo) G1(wi), alpha = roughness^2, and visible-normal sampling (Heitz 2018).
-//! Lobes with alpha below [`ALPHA_MIN`] are smooth (delta) lobes.
-//!
-//! `eval` returns the non-delta part: `f * |cos_i|` and the density with which `sample`
-//! produces `wi` (its lobe's weight times the lobe's pdf, summed over non-delta lobes).
-//! `sample` picks a lobe with probability equal to its weight; a non-delta sample returns
-//! `eval / pdf` of the whole mixture (one-sample MIS over the lobes).
+//! What every material model shares: the result types of a BSDF, Fresnel reflectance, the
+//! GGX microfacet distribution (Mitsuba 3's separable Smith term G1(wo) G1(wi), alpha =
+//! roughness^2, visible-normal sampling after Heitz 2018), smooth and rough dielectric
+//! interfaces (Walter et al. 2007 in pbrt-v4's formulation, exact Fresnel), and the sample
+//! of a continuous mixture. Lobes with alpha below [`ALPHA_MIN`] are smooth (delta) lobes.
+//! Twin of `microfacet.wgsl`.
 
-use std::f32::consts::{FRAC_1_PI, PI};
+use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3A};
-use pathlight_core::gpu_types::GpuMaterial;
 
-use crate::sampling::{Frame, sample_cosine_hemisphere, sin_cos_turns};
+use crate::sampling::{Frame, sin_cos_turns};
 use crate::surface::Surface;
 
 /// GGX alpha below which a lobe is treated as perfectly smooth.
@@ -51,7 +42,8 @@ pub struct BsdfSample {
     pub valid: bool,
 }
 
-pub(crate) const INVALID: BsdfSample = BsdfSample {
+/// No sample (twin of WGSL `invalid_sample`).
+pub const INVALID: BsdfSample = BsdfSample {
     wi: Vec3A::ZERO,
     weight: Vec3A::ZERO,
     pdf: 0.0,
@@ -92,16 +84,6 @@ pub fn fresnel_conductor(cos_i: f32, eta: Vec3A, k: Vec3A) -> Vec3A {
     let t4 = t2 * sin2;
     let rp = rs * (t3 - t4) / (t3 + t4).max(Vec3A::splat(1e-20));
     0.5 * (rp + rs)
-}
-
-/// Reflectance of the specular lobe at `cos_i`. Twin of WGSL `specular_reflectance`.
-#[inline(always)]
-fn specular_reflectance(m: &GpuMaterial, color: Vec3A, cos_i: f32) -> Vec3A {
-    if m.conductor != 0 {
-        return fresnel_conductor(cos_i, Vec3A::from(m.eta), Vec3A::from(m.k));
-    }
-    let f0 = Vec3A::ONE.lerp(color, m.specular_tint);
-    f0 + (1.0 - f0) * (1.0 - cos_i.clamp(0.0, 1.0)).powi(5)
 }
 
 /// GGX normal distribution, local `m`. Twin of WGSL `ggx_d`.
@@ -147,24 +129,14 @@ pub fn ggx_sample_visible(wo: Vec3A, alpha: f32, u: Vec2) -> Vec3A {
 
 /// Density of `ggx_sample_visible` producing `m`. Twin of WGSL `ggx_pdf_visible`.
 #[inline(always)]
-pub(crate) fn ggx_pdf_visible(wo: Vec3A, m: Vec3A, alpha: f32) -> f32 {
+pub fn ggx_pdf_visible(wo: Vec3A, m: Vec3A, alpha: f32) -> f32 {
     ggx_g1(wo, alpha) * wo.dot(m).abs() * ggx_d(m, alpha) / wo.z.abs()
-}
-
-/// Lobe weights (diffuse, specular, transmission). Twin of WGSL `lobe_weights`.
-#[inline(always)]
-fn lobe_weights(m: &GpuMaterial) -> Vec3A {
-    Vec3A::new(
-        (1.0 - m.specular_rate - m.refract_rate).max(0.0),
-        m.specular_rate,
-        m.refract_rate,
-    )
 }
 
 /// Dielectric Fresnel for local `wo` and microfacet `m` with the inside IOR `ior`
 /// (either side). Twin of WGSL `fresnel_dielectric_local`.
 #[inline(always)]
-fn fresnel_dielectric_local(cos_om: f32, ior: f32) -> f32 {
+pub fn fresnel_dielectric_local(cos_om: f32, ior: f32) -> f32 {
     if cos_om >= 0.0 {
         fresnel_dielectric(cos_om, ior)
     } else {
@@ -172,53 +144,14 @@ fn fresnel_dielectric_local(cos_om: f32, ior: f32) -> f32 {
     }
 }
 
-/// The continuous part of the BSDF. Twin of WGSL `eval_bsdf`.
+/// Rough dielectric of inside index `ior` (pbrt-v4 `DielectricBxDF::f` and `PDF`, separable
+/// Smith) in the frame of the outward shading normal, the transmission tinted by
+/// `lerp(1, color, tint)`. Twin of WGSL `eval_rough_dielectric`.
 #[inline(always)]
-pub fn eval_bsdf(m: &GpuMaterial, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfEval {
-    let weights = lobe_weights(m);
-    let front = wo.dot(s.ng) >= 0.0;
-    let sign = if front { 1.0 } else { -1.0 };
-    let ng = s.ng * sign;
-    let n = s.ns * sign;
-    let mut out = BsdfEval {
-        f: Vec3A::ZERO,
-        pdf: 0.0,
-    };
-    let same_side = wi.dot(ng) > 0.0;
-    let cos_o = wo.dot(n);
-    let cos_i = wi.dot(n);
-    if same_side && cos_o > 0.0 && cos_i > 0.0 {
-        if weights.x > 0.0 {
-            out.f += weights.x * color * FRAC_1_PI * cos_i;
-            out.pdf += weights.x * FRAC_1_PI * cos_i;
-        }
-        let alpha = m.specular_roughness * m.specular_roughness;
-        if weights.y > 0.0 && alpha >= ALPHA_MIN {
-            let frame = Frame::around(n);
-            let (wo_l, wi_l) = (frame.to_local(wo), frame.to_local(wi));
-            let h = (wo_l + wi_l).normalize();
-            let f = specular_reflectance(m, color, wo_l.dot(h));
-            let d = ggx_d(h, alpha);
-            let g1o = ggx_g1(wo_l, alpha);
-            out.f += weights.y * f * d * g1o * ggx_g1(wi_l, alpha) / (4.0 * wo_l.z);
-            out.pdf += weights.y * g1o * d / (4.0 * wo_l.z);
-        }
-    }
-    let alpha_t = m.refract_roughness * m.refract_roughness;
-    if weights.z > 0.0 && alpha_t >= ALPHA_MIN {
-        let e = eval_rough_dielectric(m, color, s, wo, wi, alpha_t);
-        out.f += weights.z * e.f;
-        out.pdf += weights.z * e.pdf;
-    }
-    out
-}
-
-/// Rough dielectric (pbrt-v4 `DielectricBxDF::f` and `PDF`, separable Smith) in the frame
-/// of the outward shading normal. Twin of WGSL `eval_rough_dielectric`.
-#[inline(always)]
-pub(crate) fn eval_rough_dielectric(
-    m: &GpuMaterial,
+pub fn eval_rough_dielectric(
+    ior: f32,
     color: Vec3A,
+    tint: f32,
     s: &Surface,
     wo: Vec3A,
     wi: Vec3A,
@@ -240,9 +173,9 @@ pub(crate) fn eval_rough_dielectric(
     let etap = if reflect {
         1.0
     } else if cos_o > 0.0 {
-        m.ior
+        ior
     } else {
-        1.0 / m.ior
+        1.0 / ior
     };
     let mut h = wi_l * etap + wo_l;
     if h.length_squared() == 0.0 {
@@ -255,7 +188,7 @@ pub(crate) fn eval_rough_dielectric(
     if h.dot(wi_l) * cos_i < 0.0 || h.dot(wo_l) * cos_o < 0.0 {
         return none;
     }
-    let fr = fresnel_dielectric_local(wo_l.dot(h), m.ior);
+    let fr = fresnel_dielectric_local(wo_l.dot(h), ior);
     let d = ggx_d(h, alpha);
     let g = ggx_g1(wo_l, alpha) * ggx_g1(wi_l, alpha);
     let pdf_h = ggx_pdf_visible(wo_l, h, alpha);
@@ -266,7 +199,7 @@ pub(crate) fn eval_rough_dielectric(
         }
     } else {
         let denom = (wi_l.dot(h) + wo_l.dot(h) / etap).powi(2);
-        let tint = Vec3A::ONE.lerp(color, m.refract_tint);
+        let tint = Vec3A::ONE.lerp(color, tint);
         let ft = (1.0 - fr) * d * g * (wi_l.dot(h) * wo_l.dot(h)).abs()
             / (cos_o.abs() * denom)
             / (etap * etap);
@@ -277,102 +210,11 @@ pub(crate) fn eval_rough_dielectric(
     }
 }
 
-/// `f / pdf` of the whole mixture at a sampled non-delta `wi`. Twin of WGSL `mixture_sample`.
-#[inline(always)]
-fn mixture_sample(m: &GpuMaterial, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfSample {
-    let e = eval_bsdf(m, color, s, wo, wi);
-    if e.pdf <= 0.0 || !e.pdf.is_finite() {
-        return INVALID;
-    }
-    // A direction on the other side of the geometric surface crossed the dielectric.
-    let eta = if (wo.dot(s.ng) >= 0.0) == (wi.dot(s.ng) >= 0.0) {
-        1.0
-    } else if wo.dot(s.ng) >= 0.0 {
-        m.ior
-    } else {
-        1.0 / m.ior
-    };
-    BsdfSample {
-        wi,
-        weight: e.f / e.pdf,
-        pdf: e.pdf,
-        delta: false,
-        eta,
-        valid: true,
-    }
-}
-
-/// Samples an incident direction. Twin of WGSL `sample_bsdf`.
-#[inline(always)]
-pub fn sample_bsdf(
-    m: &GpuMaterial,
-    color: Vec3A,
-    s: &Surface,
-    wo: Vec3A,
-    u_lobe: f32,
-    u_fresnel: f32,
-    u: Vec2,
-) -> BsdfSample {
-    let weights = lobe_weights(m);
-    let front = wo.dot(s.ng) >= 0.0;
-    let sign = if front { 1.0 } else { -1.0 };
-    let ng = s.ng * sign;
-    let n = s.ns * sign;
-    let cos_o = wo.dot(n);
-    if u_lobe < weights.y {
-        if cos_o <= 0.0 {
-            return INVALID;
-        }
-        let alpha = m.specular_roughness * m.specular_roughness;
-        if alpha < ALPHA_MIN {
-            let wi = 2.0 * cos_o * n - wo;
-            if wi.dot(ng) <= 0.0 {
-                return INVALID;
-            }
-            let weight = specular_reflectance(m, color, cos_o);
-            return BsdfSample {
-                wi,
-                weight,
-                pdf: 0.0,
-                delta: true,
-                eta: 1.0,
-                valid: true,
-            };
-        }
-        let frame = Frame::around(n);
-        let wo_l = frame.to_local(wo);
-        let h = ggx_sample_visible(wo_l, alpha, u);
-        let wi_l = 2.0 * wo_l.dot(h) * h - wo_l;
-        if wi_l.z <= 0.0 {
-            return INVALID;
-        }
-        return mixture_sample(m, color, s, wo, frame.to_world(wi_l));
-    }
-    if u_lobe < weights.y + weights.z {
-        let alpha = m.refract_roughness * m.refract_roughness;
-        if alpha < ALPHA_MIN {
-            return sample_smooth_dielectric(m, color, s, wo, u_fresnel);
-        }
-        return match rough_dielectric_direction(m.ior, s, wo, alpha, u_fresnel, u) {
-            Some(wi) => mixture_sample(m, color, s, wo, wi),
-            None => INVALID,
-        };
-    }
-    if cos_o <= 0.0 {
-        return INVALID;
-    }
-    let wi = Frame::around(n).to_world(sample_cosine_hemisphere(u));
-    if wi.dot(ng) <= 0.0 {
-        return INVALID;
-    }
-    mixture_sample(m, color, s, wo, wi)
-}
-
 /// A direction sampled from a rough dielectric interface of relative index `ior` about
 /// `s.ns`: reflection or refraction of a visible GGX normal, chosen by its Fresnel
 /// reflectance. Twin of WGSL `rough_dielectric_direction`.
 #[inline(always)]
-pub(crate) fn rough_dielectric_direction(
+pub fn rough_dielectric_direction(
     ior: f32,
     s: &Surface,
     wo: Vec3A,
@@ -413,12 +255,14 @@ pub(crate) fn rough_dielectric_direction(
     Some(frame.to_world(wi_l))
 }
 
-/// Smooth dielectric: reflect with probability F, else refract; radiance scaled by
-/// 1/eta^2 on refraction (as Mitsuba and pbrt do). Twin of WGSL `sample_smooth_dielectric`.
+/// Smooth dielectric of inside index `ior`: reflect with probability F, else refract, tinted
+/// by `lerp(1, color, tint)`; radiance scaled by 1/eta^2 on refraction (as Mitsuba and pbrt
+/// do). Twin of WGSL `sample_smooth_dielectric`.
 #[inline(always)]
-pub(crate) fn sample_smooth_dielectric(
-    m: &GpuMaterial,
+pub fn sample_smooth_dielectric(
+    ior: f32,
     color: Vec3A,
+    tint: f32,
     s: &Surface,
     wo: Vec3A,
     u_fresnel: f32,
@@ -431,7 +275,7 @@ pub(crate) fn sample_smooth_dielectric(
     if cos_o <= 0.0 {
         return INVALID;
     }
-    let eta = if front { m.ior } else { 1.0 / m.ior };
+    let eta = if front { ior } else { 1.0 / ior };
     let f = fresnel_dielectric(cos_o, eta);
     if u_fresnel < f {
         let wi = 2.0 * cos_o * n - wo;
@@ -448,7 +292,7 @@ pub(crate) fn sample_smooth_dielectric(
     let sin2_t = (1.0 - cos_o * cos_o) / (eta * eta);
     let cos_t = (1.0 - sin2_t).max(0.0).sqrt();
     let wi = -wo / eta + (cos_o / eta - cos_t) * n;
-    let weight = Vec3A::ONE.lerp(color, m.refract_tint) / (eta * eta);
+    let weight = Vec3A::ONE.lerp(color, tint) / (eta * eta);
     BsdfSample {
         wi,
         weight,
@@ -459,12 +303,29 @@ pub(crate) fn sample_smooth_dielectric(
     }
 }
 
-/// Whether the material has a non-delta lobe (next-event estimation is worth doing).
-/// Twin of WGSL `has_continuous_lobe`.
+/// The sample of a mixture's continuous lobe in direction `wi`: eval / pdf of the whole
+/// mixture (`e`, evaluated at `wi`), and the relative IOR crossed when `wi` lies across the
+/// geometric surface from `wo` (an interface of inside index `ior`; 1 for a thin wall).
+/// Twin of WGSL `continuous_sample`.
 #[inline(always)]
-pub fn has_continuous_lobe(m: &GpuMaterial) -> bool {
-    let w = lobe_weights(m);
-    w.x > 0.0
-        || (w.y > 0.0 && m.specular_roughness * m.specular_roughness >= ALPHA_MIN)
-        || (w.z > 0.0 && m.refract_roughness * m.refract_roughness >= ALPHA_MIN)
+pub fn continuous_sample(e: BsdfEval, s: &Surface, wo: Vec3A, wi: Vec3A, ior: f32) -> BsdfSample {
+    if e.pdf <= 0.0 || !e.pdf.is_finite() {
+        return INVALID;
+    }
+    // A direction on the other side of the geometric surface crossed the dielectric.
+    let eta = if (wo.dot(s.ng) >= 0.0) == (wi.dot(s.ng) >= 0.0) {
+        1.0
+    } else if wo.dot(s.ng) >= 0.0 {
+        ior
+    } else {
+        1.0 / ior
+    };
+    BsdfSample {
+        wi,
+        weight: e.f / e.pdf,
+        pdf: e.pdf,
+        delta: false,
+        eta,
+        valid: true,
+    }
 }

@@ -10,6 +10,7 @@
 #import sampling
 #import environment
 #import surface
+#import material
 
 // CPU twin: `LightSample`.
 struct LightSample {
@@ -220,7 +221,7 @@ fn sample_light(p: vec3f, n: vec3f, u_select: f32, u: vec2f) -> LightSample {
     }
     var radiance = materials[o.material].emission;
     if o.kind == KIND_MESH {
-        radiance = material_at(materials[o.material], triangle_uv(light.primitive, ss.barycentrics.x, ss.barycentrics.y)).emission;
+        radiance = emission_at(o.material, triangle_uv(light.primitive, ss.barycentrics.x, ss.barycentrics.y));
     }
     return LightSample(wi, ss.point, true, radiance, pdf, pdf > 0.0 && pdf <= 3.0e38);
 }

@@ -6,7 +6,7 @@
 
 use pathlight_core::{PreparedScene, Renderer};
 use pathlight_cpu::CpuRenderer;
-use pathlight_render::{Accel, GpuContext, GpuRenderer};
+use pathlight_gpu::{Accel, GpuContext, GpuRenderer};
 use pathlight_scene::Scene;
 
 /// Submissions measured after the warm-up.

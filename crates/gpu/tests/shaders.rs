@@ -8,10 +8,10 @@ use std::mem::{offset_of, size_of};
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use pathlight_core::gpu_types::{
     GpuAccumPixel, GpuCamera, GpuLight, GpuMaterial, GpuObject, GpuPrimitive, GpuRenderParams,
-    GpuTextureInfo, GpuTextureSlot, GpuVertex, GpuWideNode,
+    GpuTextureSlot, GpuVertex, GpuWideNode,
 };
-use pathlight_render::display::GpuDisplayParams;
-use pathlight_render::wgsl::{self, AssemblyError};
+use pathlight_gpu::display::GpuDisplayParams;
+use pathlight_gpu::wgsl::{self, AssemblyError};
 
 fn parse_and_validate(label: &str, source: &str) -> naga::Module {
     let module = naga::front::wgsl::parse_str(source)
@@ -133,7 +133,12 @@ fn host_structs_match_their_wgsl_declarations() {
         GpuVertex,
         [position, normal, uv, tangent, tangent_sign]
     );
-    assert_layout!(m, "TextureSlot", GpuTextureSlot, [u, texture, v, wrap]);
+    assert_layout!(
+        m,
+        "TextureSlot",
+        GpuTextureSlot,
+        [u, offset, v, wrap, width, height]
+    );
     assert_layout!(
         m,
         "Primitive",
@@ -148,27 +153,15 @@ fn host_structs_match_their_wgsl_declarations() {
             base_color,
             model,
             emission,
-            specular_rate,
-            eta,
-            specular_tint,
-            k,
-            specular_roughness,
-            refract_rate,
-            refract_tint,
-            ior,
-            refract_roughness,
-            conductor,
-            metallic,
-            roughness,
-            transmission,
-            normal_scale,
+            flags,
             alpha_cutoff,
             alpha_factor,
-            flags,
-            slots
+            normal_scale,
+            params,
+            textures,
+            texture_mask
         ]
     );
-    assert_layout!(m, "TextureInfo", GpuTextureInfo, [offset, width, height]);
     assert_layout!(
         m,
         "CameraParams",
@@ -232,4 +225,54 @@ fn host_structs_match_their_wgsl_declarations() {
             encode_srgb
         ]
     );
+}
+
+/// The value of WGSL constant `name` (an integer literal) in `module`.
+fn wgsl_constant(module: &naga::Module, name: &str) -> u32 {
+    let (_, constant) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("const {name} is not declared"));
+    match module.global_expressions[constant.init] {
+        naga::Expression::Literal(naga::Literal::U32(v)) => v,
+        ref other => panic!("const {name} is {other:?}, not a u32 literal"),
+    }
+}
+
+/// Every constant the host and the WGSL both name has one value.
+#[test]
+fn host_constants_match_their_wgsl_declarations() {
+    use pathlight_core::gpu_types as t;
+    use pathlight_core::materials as m;
+    let integrator = module("integrator");
+    let pairs = [
+        ("KIND_QUAD", t::KIND_QUAD),
+        ("KIND_SPHERE", t::KIND_SPHERE),
+        ("KIND_CYLINDER", t::KIND_CYLINDER),
+        ("KIND_MESH", t::KIND_MESH),
+        ("FLAG_FLAT", t::FLAG_FLAT),
+        ("FLAG_CAPS", t::FLAG_CAPS),
+        ("FLAG_ALPHA", t::FLAG_ALPHA),
+        ("NO_LIGHT", t::NO_LIGHT),
+        ("NO_TRIANGLE", t::NO_TRIANGLE),
+        ("SHAPE_LEAF", t::SHAPE_LEAF),
+        ("MATERIAL_MASK", t::MATERIAL_MASK),
+        ("MATERIAL_BLEND", t::MATERIAL_BLEND),
+        ("TEXTURE_BASE", t::TEXTURE_BASE),
+        ("TEXTURE_NORMAL", t::TEXTURE_NORMAL),
+        ("TEXTURE_EMISSION", t::TEXTURE_EMISSION),
+        ("TEXTURE_MODEL", t::TEXTURE_MODEL),
+        ("WRAP_REPEAT", t::WRAP_REPEAT),
+        ("WRAP_CLAMP", t::WRAP_CLAMP),
+        ("WRAP_MIRROR", t::WRAP_MIRROR),
+        ("SAMPLER_SOBOL", t::SAMPLER_SOBOL),
+        ("SAMPLER_INDEPENDENT", t::SAMPLER_INDEPENDENT),
+        ("MODEL_LOBES", m::MODEL_LOBES),
+        ("MODEL_METAL_ROUGH", m::MODEL_METAL_ROUGH),
+        ("MODEL_PARAMS", m::MODEL_PARAMS as u32),
+    ];
+    for (name, host) in pairs {
+        assert_eq!(wgsl_constant(&integrator, name), host, "{name}");
+    }
 }

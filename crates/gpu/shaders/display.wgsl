@@ -1,8 +1,8 @@
 // The viewer's display pass: one full-screen triangle whose fragments read the linear
 // accumulation (fixed-point sums, see integrator.wgsl), divide by the sample count, apply
 // exposure and an optional tone mapper, and encode sRGB unless the surface does. The
-// accumulation itself is never changed. Host: `crates/render/src/display.rs`. The CPU
-// backend's viewer runs the CPU twin, `crates/cpu/src/display.rs`.
+// accumulation itself is never changed. Host: `crates/gpu/src/display.rs`. The CPU
+// backend's viewer runs its CPU twin: `crates/cpu/src/display.rs`.
 
 // Host: `GpuDisplayParams`.
 struct DisplayParams {

@@ -1,7 +1,8 @@
 //! The prepared scene on the device: bind group 0 of every ray-casting pass
 //! (`shaders/scene.wgsl`, `shaders/environment.wgsl`). The geometry, the textures and the
-//! environment map are uploaded once; the shading
-//! (objects with their materials, materials, light table) is uploaded again when it changes.
+//! environment map are uploaded once; the shading (objects with their materials,
+//! materials with their parameters and texture slots, light table) is uploaded again when it
+//! changes.
 
 use pathlight_core::gpu_types::GpuPrimitive;
 use pathlight_core::{EnvironmentData, Geometry, PreparedScene, RenderError, Shading, Textures};
@@ -14,7 +15,7 @@ use crate::pipeline::{bind_buffers, storage_entry};
 const MAX_NODES: usize = 1 << 28;
 
 /// Bindings of `scene.wgsl` and `environment.wgsl`, by number.
-const BINDINGS: usize = 11;
+const BINDINGS: usize = 12;
 
 /// The scene's buffers on the device and the bind group over them.
 #[derive(Debug)]
@@ -77,12 +78,9 @@ fn geometry_contents(geometry: &Geometry) -> [(usize, &'static str, &[u8]); 4] {
     ]
 }
 
-/// The texture buffers: bindings 4 (table) and 5 (texels).
-fn texture_contents(textures: &Textures) -> [(usize, &'static str, &[u8]); 2] {
-    [
-        (4, "texture table", bytemuck::cast_slice(&textures.infos)),
-        (5, "texels", bytemuck::cast_slice(&textures.texels)),
-    ]
+/// The texture buffer: binding 5 (texels).
+fn texture_contents(textures: &Textures) -> [(usize, &'static str, &[u8]); 1] {
+    [(5, "texels", bytemuck::cast_slice(&textures.texels))]
 }
 
 /// The environment map's buffers: bindings 9 (texels) and 10 (distribution).
@@ -101,12 +99,23 @@ fn environment_contents(environment: &EnvironmentData) -> [(usize, &'static str,
     ]
 }
 
-/// The shading buffers: bindings 1 (objects), 3 (materials) and 6 (lights).
-fn shading_contents(shading: &Shading) -> [(usize, &'static str, &[u8]); 3] {
+/// The shading buffers: bindings 1 (objects), 3 (materials), 4 (texture slots), 6
+/// (lights) and 11 (material parameters).
+fn shading_contents(shading: &Shading) -> [(usize, &'static str, &[u8]); 5] {
     [
         (1, "objects", bytemuck::cast_slice(&shading.objects)),
         (3, "materials", bytemuck::cast_slice(&shading.materials)),
+        (
+            4,
+            "texture slots",
+            bytemuck::cast_slice(&shading.texture_slots),
+        ),
         (6, "lights", bytemuck::cast_slice(&shading.lights)),
+        (
+            11,
+            "material parameters",
+            bytemuck::cast_slice(&shading.material_params),
+        ),
     ]
 }
 

@@ -1,4 +1,5 @@
-// From a hit to the local surface: position, normals, texture coordinates, base colour.
+// From a hit to the local surface: position, normals (normal maps applied), texture
+// coordinates, material.
 // CPU twin: `crates/cpu/src/surface.rs`.
 
 #import scene
@@ -30,41 +31,17 @@ fn decode_unit(code: u32) -> vec3f {
     return normalize(vec3f(e.x + select(t, -t, e.x >= 0.0), e.y + select(t, -t, e.y >= 0.0), z));
 }
 
-// The material with its textures applied at `uv`: the lobes' base colour replaced by its
-// texture; the metal-rough base colour, metallic, roughness and emission multiplied by theirs.
-// CPU twin: `material_at`.
-fn material_at(material: Material, uv: vec2f) -> Material {
-    var m = material;
-    if m.slots[SLOT_BASE].texture >= 0 {
-        let color = srgb_to_linear(sample_slot(m.slots[SLOT_BASE], uv).rgb);
-        m.base_color = select(color, m.base_color * color, m.model == MODEL_METAL_ROUGH);
-    }
-    if m.model != MODEL_METAL_ROUGH {
-        return m;
-    }
-    if m.slots[SLOT_METAL_ROUGH].texture >= 0 {
-        let t = sample_slot(m.slots[SLOT_METAL_ROUGH], uv);
-        m.roughness *= t.g;
-        m.metallic *= t.b;
-    }
-    if m.slots[SLOT_EMISSION].texture >= 0 {
-        m.emission *= srgb_to_linear(sample_slot(m.slots[SLOT_EMISSION], uv).rgb);
-    }
-    return m;
-}
-
 // The shading normal `ns` bent by material `m`'s normal map at `uv`, in the frame of the
 // corner-interpolated tangent `tangent` (bitangent cross(ns, tangent) * sign).
 // CPU twin: `normal_mapped`.
-fn normal_mapped(material: u32, uv: vec2f, ns: vec3f, tangent: vec3f, sign: f32) -> vec3f {
-    let m = materials[material];
+fn normal_mapped(m: Material, uv: vec2f, ns: vec3f, tangent: vec3f, sign: f32) -> vec3f {
     let t = tangent - dot(tangent, ns) * ns;
     if dot(t, t) < 1e-12 {
         return ns;
     }
     let tn = normalize(t);
     let b = cross(ns, tn) * sign;
-    let c = sample_slot(m.slots[SLOT_NORMAL], uv).xyz * 2.0 - 1.0;
+    let c = material_texture(m, TEXTURE_NORMAL, uv).xyz * 2.0 - 1.0;
     let n = tn * (c.x * m.normal_scale) + b * (c.y * m.normal_scale) + ns * c.z;
     if dot(n, n) < 1e-12 {
         return ns;
@@ -123,9 +100,10 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
             } else {
                 s.ns = normalize(n);
             }
-            if materials[o.material].model == MODEL_METAL_ROUGH && materials[o.material].slots[SLOT_NORMAL].texture >= 0 {
+            let m = materials[o.material];
+            if has_texture(m, TEXTURE_NORMAL) {
                 let tangent = b0 * decode_unit(v0.tangent) + hit.b1 * decode_unit(v1.tangent) + hit.b2 * decode_unit(v2.tangent);
-                s.ns = normal_mapped(o.material, s.uv, s.ns, tangent, v0.tangent_sign);
+                s.ns = normal_mapped(m, s.uv, s.ns, tangent, v0.tangent_sign);
             }
             if dot(s.ns, s.ng) < 0.0 {
                 s.ns = -s.ns;

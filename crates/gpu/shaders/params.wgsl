@@ -2,6 +2,7 @@
 // camera, the image and the band of rows a dispatch covers, the settings, and the split
 // between the environment and the shape lights. Host: `crates/core/src/params.rs` fills
 // them; their layout is `GpuCamera` and `GpuRenderParams` in `crates/core/src/gpu_types.rs`.
+// No CPU twin: declarations only (the CPU backend reads the host structs).
 
 // The eye and the image plane at unit distance: a point at normalised device coordinates
 // (x, y) in [-1, 1] lies along forward + x right + y up. Host: `GpuCamera`.
@@ -54,5 +55,5 @@ struct RenderParams {
 // A read-only storage buffer, not a uniform: on lavapipe (Mesa 22.3, measured) every
 // submission grew the process by 2.6 MB and paid a shader compile while `sample_offset`
 // changed in a uniform buffer (lavapipe inlines uniform values into shader variants, which it
-// keeps); as storage it stays flat (crates/render/tests/memory.rs).
+// keeps); as storage it stays flat (crates/gpu/tests/memory.rs).
 @group(1) @binding(0) var<storage, read> params: RenderParams;

@@ -5,7 +5,7 @@
 use pathlight_core::ToneMap;
 use pathlight_core::gpu_types::GpuAccumPixel;
 use pathlight_cpu::display::{ChannelOrder, CpuDisplay, DisplayImage};
-use pathlight_render::display::{DisplayPass, DisplaySource};
+use pathlight_gpu::display::{DisplayPass, DisplaySource};
 use rand::{Rng, SeedableRng};
 use wgpu::util::DeviceExt;
 

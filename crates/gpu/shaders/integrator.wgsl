@@ -12,8 +12,7 @@
 #import sampler
 #import camera
 #import surface
-#import bsdf
-#import metal_rough
+#import material
 #import lights
 
 // Running sum of samples per channel as a 64-bit fixed-point number hi + lo / 2^32.
@@ -142,7 +141,7 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
             break;
         }
         let s = surface_at(hit, ray);
-        let material = material_at(materials[s.material], s.uv);
+        let material = material_at(s.material, s.uv);
         let wo = -ray.dir;
         if dot(wo, s.ng) > 0.0 && max(max(material.emission.x, material.emission.y), material.emission.z) > 0.0 {
             var w = 1.0;

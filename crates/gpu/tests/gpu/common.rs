@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use pathlight_core::{Film, PreparedScene, Renderer};
-use pathlight_render::{Accel, GpuContext, GpuRenderer};
+use pathlight_gpu::{Accel, GpuContext, GpuRenderer};
 use pathlight_scene::{Scene, load_scene_file};
 
 /// The device every test of this binary shares (the software adapter on CI).

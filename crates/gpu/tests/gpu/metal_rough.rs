@@ -6,7 +6,7 @@
 use glam::{Vec2, Vec3};
 use pathlight_core::Film;
 use pathlight_scene::{
-    AlphaMode, Environment, Lobes, Material, MetalRough, Object, Scene, Shape, Texture, TextureRef,
+    AlphaMode, Environment, Material, MetalRough, Model, Object, Scene, Shape, Texture, TextureRef,
     TriangleMesh, Wrap,
 };
 
@@ -14,15 +14,7 @@ use crate::common::{render, render_cpu, scene};
 
 /// A metal-rough material of base colour `color`.
 fn metal_rough(name: &str, color: Vec3, pbr: MetalRough) -> Material {
-    Material {
-        name: name.into(),
-        base_color: color,
-        texture: None,
-        emission: Vec3::ZERO,
-        lobes: Lobes::DIFFUSE,
-        conductor: None,
-        metal_rough: Some(pbr),
-    }
+    Material::new(name, color, Model::MetalRough(pbr))
 }
 
 /// White furnaces (constant radiance 1) where every path carries weight 1: a smooth white
@@ -182,14 +174,8 @@ fn an_alpha_masked_quad_casts_the_shadow_of_its_opaque_part() {
     let origin = Vec3::new(-1.0, 0.5, 1.0);
     // 16 texels: 8 transparent, 8 opaque; bilinear alpha crosses 0.5 at u = 0.5 exactly.
     let mask = strip(16, |x| [255, 255, 255, if x < 8 { 0 } else { 255 }]);
-    let mut masked = metal_rough(
-        "masked",
-        Vec3::splat(0.5),
-        MetalRough {
-            alpha: AlphaMode::Mask(0.5),
-            ..MetalRough::DEFAULT
-        },
-    );
+    let mut masked = metal_rough("masked", Vec3::splat(0.5), MetalRough::DEFAULT);
+    masked.alpha = AlphaMode::Mask(0.5);
     masked.texture = Some(TextureRef {
         texture: 0,
         transform: TextureRef::IDENTITY,
@@ -253,19 +239,12 @@ fn a_normal_map_shades_like_the_normals_it_encodes() {
     // Tangent +x, bitangent cross(n, t) = cross(y, x) = -z = the direction of +v.
     let tilted = (decoded.x * Vec3::X + decoded.y * Vec3::NEG_Z + decoded.z * Vec3::Y).normalize();
     let mapped_material = {
-        let mut m = metal_rough(
-            "mapped",
-            Vec3::splat(0.7),
-            MetalRough {
-                normal_texture: Some(TextureRef {
-                    texture: 0,
-                    transform: TextureRef::IDENTITY,
-                    wrap: [Wrap::Repeat; 2],
-                }),
-                ..MetalRough::DEFAULT
-            },
-        );
-        m.base_color = Vec3::splat(0.7);
+        let mut m = metal_rough("mapped", Vec3::splat(0.7), MetalRough::DEFAULT);
+        m.normal_texture = Some(TextureRef {
+            texture: 0,
+            transform: TextureRef::IDENTITY,
+            wrap: [Wrap::Repeat; 2],
+        });
         m
     };
     let plain = metal_rough("plain", Vec3::splat(0.7), MetalRough::DEFAULT);

@@ -1,11 +1,8 @@
-// The material model. CPU twin: `crates/cpu/src/bsdf.rs` (read its header for the model).
-//
-// A mixture of lobes with the seed's weights: Lambert, specular reflection (smooth mirror
-// or GGX conductor: complex-IOR Fresnel, or Schlick from the specular colour) and
-// transmission (smooth or GGX-rough dielectric, Walter et al. 2007 as in pbrt-v4, exact
-// Fresnel). GGX: separable Smith G1(wo) G1(wi) as in Mitsuba 3, alpha = roughness^2,
-// visible-normal sampling (Heitz 2018). `eval_bsdf` returns f * |cos_i| of the non-delta
-// lobes and the density of `sample_bsdf` producing wi.
+// What every material model shares: the result types of a BSDF, Fresnel reflectance, the
+// GGX microfacet distribution (separable Smith G1(wo) G1(wi) as in Mitsuba 3, alpha =
+// roughness^2, visible-normal sampling after Heitz 2018), smooth and rough dielectric
+// interfaces (Walter et al. 2007 in pbrt-v4's form, exact Fresnel), and the sample of a
+// continuous mixture. CPU twin: `crates/cpu/src/microfacet.rs`.
 
 #import scene
 #import surface
@@ -72,15 +69,6 @@ fn fresnel_conductor(cos_i: f32, eta: vec3f, k: vec3f) -> vec3f {
     return 0.5 * (rp + rs);
 }
 
-// CPU twin: `specular_reflectance`.
-fn specular_reflectance(m: Material, color: vec3f, cos_i: f32) -> vec3f {
-    if m.conductor != 0u {
-        return fresnel_conductor(cos_i, m.eta, m.k);
-    }
-    let f0 = mix(vec3f(1.0), color, m.specular_tint);
-    return f0 + (1.0 - f0) * pow(1.0 - saturate(cos_i), 5.0);
-}
-
 // CPU twin: `ggx_d`.
 fn ggx_d(m: vec3f, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
@@ -119,11 +107,6 @@ fn ggx_pdf_visible(wo: vec3f, m: vec3f, alpha: f32) -> f32 {
     return ggx_g1(wo, alpha) * abs(dot(wo, m)) * ggx_d(m, alpha) / abs(wo.z);
 }
 
-// CPU twin: `lobe_weights`.
-fn lobe_weights(m: Material) -> vec3f {
-    return vec3f(max(0.0, 1.0 - m.specular_rate - m.refract_rate), m.specular_rate, m.refract_rate);
-}
-
 // CPU twin: `fresnel_dielectric_local`.
 fn fresnel_dielectric_local(cos_om: f32, ior: f32) -> f32 {
     if cos_om >= 0.0 {
@@ -132,8 +115,11 @@ fn fresnel_dielectric_local(cos_om: f32, ior: f32) -> f32 {
     return fresnel_dielectric(-cos_om, 1.0 / ior);
 }
 
+// A rough dielectric interface of inside index `ior` about `s.ns`: f * |cos_i| and the
+// density of `rough_dielectric_direction`; the transmission is tinted by
+// mix(1, color, tint).
 // CPU twin: `eval_rough_dielectric`.
-fn eval_rough_dielectric(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: vec3f, alpha: f32) -> BsdfEval {
+fn eval_rough_dielectric(ior: f32, color: vec3f, tint_amount: f32, s: Surface, wo: vec3f, wi: vec3f, alpha: f32) -> BsdfEval {
     let none = BsdfEval(vec3f(0.0), 0.0);
     let frame = frame_around(s.ns);
     let wo_l = to_local(frame, wo);
@@ -147,7 +133,7 @@ fn eval_rough_dielectric(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: v
     }
     var etap = 1.0;
     if !reflect {
-        etap = select(1.0 / m.ior, m.ior, cos_o > 0.0);
+        etap = select(1.0 / ior, ior, cos_o > 0.0);
     }
     var h = wi_l * etap + wo_l;
     if dot(h, h) == 0.0 {
@@ -160,7 +146,7 @@ fn eval_rough_dielectric(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: v
     if dot(h, wi_l) * cos_i < 0.0 || dot(h, wo_l) * cos_o < 0.0 {
         return none;
     }
-    let fr = fresnel_dielectric_local(dot(wo_l, h), m.ior);
+    let fr = fresnel_dielectric_local(dot(wo_l, h), ior);
     let d = ggx_d(h, alpha);
     let g = ggx_g1(wo_l, alpha) * ggx_g1(wi_l, alpha);
     let pdf_h = ggx_pdf_visible(wo_l, h, alpha);
@@ -169,63 +155,15 @@ fn eval_rough_dielectric(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: v
     }
     let x = dot(wi_l, h) + dot(wo_l, h) / etap;
     let denom = x * x;
-    let tint = mix(vec3f(1.0), color, m.refract_tint);
+    let tint = mix(vec3f(1.0), color, tint_amount);
     let ft = (1.0 - fr) * d * g * abs(dot(wi_l, h) * dot(wo_l, h)) / (abs(cos_o) * denom) / (etap * etap);
     return BsdfEval(tint * ft, pdf_h * abs(dot(wi_l, h)) / denom * (1.0 - fr));
 }
 
-// CPU twin: `eval_bsdf`.
-fn eval_bsdf(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: vec3f) -> BsdfEval {
-    let weights = lobe_weights(m);
-    let front = dot(wo, s.ng) >= 0.0;
-    let ng = select(-s.ng, s.ng, front);
-    let n = select(-s.ns, s.ns, front);
-    var out = BsdfEval(vec3f(0.0), 0.0);
-    let cos_o = dot(wo, n);
-    let cos_i = dot(wi, n);
-    if dot(wi, ng) > 0.0 && cos_o > 0.0 && cos_i > 0.0 {
-        if weights.x > 0.0 {
-            out.f += weights.x * color * (cos_i / PI);
-            out.pdf += weights.x * cos_i / PI;
-        }
-        let alpha = m.specular_roughness * m.specular_roughness;
-        if weights.y > 0.0 && alpha >= ALPHA_MIN {
-            let frame = frame_around(n);
-            let wo_l = to_local(frame, wo);
-            let wi_l = to_local(frame, wi);
-            let h = normalize(wo_l + wi_l);
-            let f = specular_reflectance(m, color, dot(wo_l, h));
-            let d = ggx_d(h, alpha);
-            let g1o = ggx_g1(wo_l, alpha);
-            out.f += weights.y * f * d * g1o * ggx_g1(wi_l, alpha) / (4.0 * wo_l.z);
-            out.pdf += weights.y * g1o * d / (4.0 * wo_l.z);
-        }
-    }
-    let alpha_t = m.refract_roughness * m.refract_roughness;
-    if weights.z > 0.0 && alpha_t >= ALPHA_MIN {
-        let e = eval_rough_dielectric(m, color, s, wo, wi, alpha_t);
-        out.f += weights.z * e.f;
-        out.pdf += weights.z * e.pdf;
-    }
-    return out;
-}
-
-// CPU twin: `mixture_sample`.
-fn mixture_sample(m: Material, color: vec3f, s: Surface, wo: vec3f, wi: vec3f) -> BsdfSample {
-    let e = eval_bsdf(m, color, s, wo, wi);
-    if !(e.pdf > 0.0 && e.pdf <= 3.0e38) {
-        return invalid_sample();
-    }
-    let front_o = dot(wo, s.ng) >= 0.0;
-    var eta = 1.0;
-    if front_o != (dot(wi, s.ng) >= 0.0) {
-        eta = select(1.0 / m.ior, m.ior, front_o);
-    }
-    return BsdfSample(wi, e.f / e.pdf, e.pdf, false, eta, true);
-}
-
+// A smooth dielectric interface of inside index `ior`: reflection with probability F, else
+// refraction tinted by mix(1, color, tint), radiance scaled by 1/eta^2.
 // CPU twin: `sample_smooth_dielectric`.
-fn sample_smooth_dielectric(m: Material, color: vec3f, s: Surface, wo: vec3f, u_fresnel: f32) -> BsdfSample {
+fn sample_smooth_dielectric(ior: f32, color: vec3f, tint_amount: f32, s: Surface, wo: vec3f, u_fresnel: f32) -> BsdfSample {
     let front = dot(wo, s.ng) >= 0.0;
     let ng = select(-s.ng, s.ng, front);
     let n = select(-s.ns, s.ns, front);
@@ -233,7 +171,7 @@ fn sample_smooth_dielectric(m: Material, color: vec3f, s: Surface, wo: vec3f, u_
     if cos_o <= 0.0 {
         return invalid_sample();
     }
-    let eta = select(1.0 / m.ior, m.ior, front);
+    let eta = select(1.0 / ior, ior, front);
     let f = fresnel_dielectric(cos_o, eta);
     if u_fresnel < f {
         let wi = 2.0 * cos_o * n - wo;
@@ -242,7 +180,7 @@ fn sample_smooth_dielectric(m: Material, color: vec3f, s: Surface, wo: vec3f, u_
     let sin2_t = (1.0 - cos_o * cos_o) / (eta * eta);
     let cos_t = sqrt(max(0.0, 1.0 - sin2_t));
     let wi = -wo / eta + (cos_o / eta - cos_t) * n;
-    let weight = mix(vec3f(1.0), color, m.refract_tint) / (eta * eta);
+    let weight = mix(vec3f(1.0), color, tint_amount) / (eta * eta);
     return BsdfSample(wi, weight, 0.0, true, eta, dot(wi, ng) < 0.0);
 }
 
@@ -282,59 +220,18 @@ fn rough_dielectric_direction(ior: f32, s: Surface, wo: vec3f, alpha: f32, u_fre
     return vec4f(frame * wi_l, 1.0);
 }
 
-// CPU twin: `sample_bsdf`.
-fn sample_bsdf(m: Material, color: vec3f, s: Surface, wo: vec3f, u_lobe: f32, u_fresnel: f32, u: vec2f) -> BsdfSample {
-    let weights = lobe_weights(m);
-    let front = dot(wo, s.ng) >= 0.0;
-    let ng = select(-s.ng, s.ng, front);
-    let n = select(-s.ns, s.ns, front);
-    let cos_o = dot(wo, n);
-    if u_lobe < weights.y {
-        if cos_o <= 0.0 {
-            return invalid_sample();
-        }
-        let alpha = m.specular_roughness * m.specular_roughness;
-        if alpha < ALPHA_MIN {
-            let wi = 2.0 * cos_o * n - wo;
-            if dot(wi, ng) <= 0.0 {
-                return invalid_sample();
-            }
-            return BsdfSample(wi, specular_reflectance(m, color, cos_o), 0.0, true, 1.0, true);
-        }
-        let frame = frame_around(n);
-        let wo_l = to_local(frame, wo);
-        let h = ggx_sample_visible(wo_l, alpha, u);
-        let wi_l = 2.0 * dot(wo_l, h) * h - wo_l;
-        if wi_l.z <= 0.0 {
-            return invalid_sample();
-        }
-        return mixture_sample(m, color, s, wo, frame * wi_l);
-    }
-    if u_lobe < weights.y + weights.z {
-        let alpha = m.refract_roughness * m.refract_roughness;
-        if alpha < ALPHA_MIN {
-            return sample_smooth_dielectric(m, color, s, wo, u_fresnel);
-        }
-        let d = rough_dielectric_direction(m.ior, s, wo, alpha, u_fresnel, u);
-        if d.w == 0.0 {
-            return invalid_sample();
-        }
-        return mixture_sample(m, color, s, wo, d.xyz);
-    }
-    if cos_o <= 0.0 {
+// The sample of a mixture's continuous lobe in direction wi: eval / pdf of the whole
+// mixture (`e`, evaluated at wi), and the relative IOR crossed when wi lies across the
+// geometric surface from wo (an interface of inside index `ior`; 1 for a thin wall).
+// CPU twin: `continuous_sample`.
+fn continuous_sample(e: BsdfEval, s: Surface, wo: vec3f, wi: vec3f, ior: f32) -> BsdfSample {
+    if !(e.pdf > 0.0 && e.pdf <= 3.0e38) {
         return invalid_sample();
     }
-    let wi = frame_around(n) * sample_cosine_hemisphere(u);
-    if dot(wi, ng) <= 0.0 {
-        return invalid_sample();
+    let front_o = dot(wo, s.ng) >= 0.0;
+    var eta = 1.0;
+    if front_o != (dot(wi, s.ng) >= 0.0) {
+        eta = select(1.0 / ior, ior, front_o);
     }
-    return mixture_sample(m, color, s, wo, wi);
-}
-
-// CPU twin: `has_continuous_lobe`.
-fn has_continuous_lobe(m: Material) -> bool {
-    let w = lobe_weights(m);
-    return w.x > 0.0
-        || (w.y > 0.0 && m.specular_roughness * m.specular_roughness >= ALPHA_MIN)
-        || (w.z > 0.0 && m.refract_roughness * m.refract_roughness >= ALPHA_MIN);
+    return BsdfSample(wi, e.f / e.pdf, e.pdf, false, eta, true);
 }

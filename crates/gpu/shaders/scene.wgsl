@@ -1,6 +1,8 @@
 // Scene data shared by every pass: struct declarations (mirrored on the host by
-// `crates/core/src/gpu_types.rs`, pinned by `crates/render/tests/shaders.rs`) and the bind
+// `crates/core/src/gpu_types.rs`, pinned by `crates/gpu/tests/shaders.rs`) and the bind
 // group 0 buffers that `pathlight_core::PreparedScene` fills.
+// No CPU twin: declarations only (the CPU backend reads the host structs, through
+// `crates/cpu/src/cpu_scene.rs`).
 
 const KIND_QUAD: u32 = 0u;
 const KIND_SPHERE: u32 = 1u;
@@ -78,69 +80,61 @@ struct Primitive {
 const NO_TRIANGLE: u32 = 0xffffffffu;
 const SHAPE_LEAF: u32 = 0x80000000u;
 
-const MODEL_LOBES: u32 = 0u;
-const MODEL_METAL_ROUGH: u32 = 1u;
-const MATERIAL_THIN: u32 = 1u;
-const MATERIAL_MASK: u32 = 2u;
-const MATERIAL_BLEND: u32 = 4u;
-const SLOT_BASE: u32 = 0u;
-const SLOT_METAL_ROUGH: u32 = 1u;
-const SLOT_NORMAL: u32 = 2u;
-const SLOT_EMISSION: u32 = 3u;
+// Vectors of a model's parameter block that the kernels load (host: `MODEL_PARAMS`).
+const MODEL_PARAMS: u32 = 4u;
+const MATERIAL_MASK: u32 = 1u;
+const MATERIAL_BLEND: u32 = 2u;
+const TEXTURE_BASE: u32 = 0u;
+const TEXTURE_NORMAL: u32 = 1u;
+const TEXTURE_EMISSION: u32 = 2u;
+const TEXTURE_MODEL: u32 = 3u;
 const WRAP_REPEAT: u32 = 0u;
 const WRAP_CLAMP: u32 = 1u;
 const WRAP_MIRROR: u32 = 2u;
 
-// One use of a texture: texture coordinates (dot(u.xy, uv) + u.z, dot(v.xy, uv) + v.z), and
-// the WRAP_ modes of u (low 2 bits) and v. Host: `GpuTextureSlot`.
+// One use of a texture: its texels from `offset` (width x height), texture coordinates
+// (dot(u.xy, uv) + u.z, dot(v.xy, uv) + v.z), and the WRAP_ modes of u (low 2 bits) and v.
+// Host: `GpuTextureSlot`.
 struct TextureSlot {
     u: vec3f,
-    texture: i32,
+    offset: u32,
     v: vec3f,
     wrap: u32,
+    width: u32,
+    height: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
-// Linear-RGB material: the seed's lobe weights or glTF's metal-rough model. Host: `GpuMaterial`.
+// A material's common part in linear RGB: its model (MODEL_* of material.wgsl) reads its
+// parameter block from `material_params[params]` on; its texture TEXTURE_* is
+// `texture_slots[textures + TEXTURE_*]`, present when that bit of `texture_mask` is set.
+// Host: `GpuMaterial`.
 struct Material {
     base_color: vec3f,
     model: u32,
     emission: vec3f,
-    specular_rate: f32,
-    eta: vec3f,
-    specular_tint: f32,
-    k: vec3f,
-    specular_roughness: f32,
-    refract_rate: f32,
-    refract_tint: f32,
-    ior: f32,
-    refract_roughness: f32,
-    conductor: u32,
-    metallic: f32,
-    roughness: f32,
-    transmission: f32,
-    normal_scale: f32,
+    flags: u32,
     alpha_cutoff: f32,
     alpha_factor: f32,
-    flags: u32,
-    slots: array<TextureSlot, 4>,
-}
-
-// Where a texture lies in `texels`. Host: `GpuTextureInfo`.
-struct TextureInfo {
-    offset: u32,
-    width: u32,
-    height: u32,
-    pad: u32,
+    normal_scale: f32,
+    params: u32,
+    textures: u32,
+    texture_mask: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
 @group(0) @binding(0) var<storage, read> nodes: array<WideNode>;
 @group(0) @binding(1) var<storage, read> objects: array<Object>;
 @group(0) @binding(2) var<storage, read> vertices: array<Vertex>;
 @group(0) @binding(3) var<storage, read> materials: array<Material>;
-@group(0) @binding(4) var<storage, read> textures: array<TextureInfo>;
+@group(0) @binding(4) var<storage, read> texture_slots: array<TextureSlot>;
 @group(0) @binding(5) var<storage, read> texels: array<u32>;
 @group(0) @binding(6) var<storage, read> lights: array<Light>;
 // The BVH's leaves index these.
 @group(0) @binding(7) var<storage, read> primitives: array<Primitive>;
 // Per BVH node, its parent's index << 2 | its lane there (`pathlight_core::bvh::parents`).
 @group(0) @binding(8) var<storage, read> parents: array<u32>;
+// The materials' parameter blocks (`pathlight_core::materials`).
+@group(0) @binding(11) var<storage, read> material_params: array<vec4f>;

@@ -11,8 +11,8 @@ fn srgb_to_linear(c: vec3f) -> vec3f {
 }
 
 // CPU twin: `texel`.
-fn texel(info: TextureInfo, x: u32, y: u32) -> vec4f {
-    return unpack4x8unorm(texels[info.offset + y * info.width + x]);
+fn texel(slot: TextureSlot, x: u32, y: u32) -> vec4f {
+    return unpack4x8unorm(texels[slot.offset + y * slot.width + x]);
 }
 
 // A coordinate folded into [0, 1] by wrap mode `mode`.
@@ -40,21 +40,32 @@ fn texel_index(i: f32, n: u32, mode: u32) -> u32 {
 // Bilinear RGBA lookup, as stored (sRGB colour channels are not decoded); row 0 is v = 0.
 // CPU twin: `sample_slot`.
 fn sample_slot(slot: TextureSlot, uv: vec2f) -> vec4f {
-    let info = textures[u32(slot.texture)];
     let mode_u = slot.wrap & 3u;
     let mode_v = (slot.wrap >> 2u) & 3u;
     let t = vec2f(dot(slot.u.xy, uv) + slot.u.z, dot(slot.v.xy, uv) + slot.v.z);
-    let size = vec2f(f32(info.width), f32(info.height));
+    let size = vec2f(f32(slot.width), f32(slot.height));
     let p = vec2f(wrap_coordinate(t.x, mode_u), wrap_coordinate(t.y, mode_v)) * size - 0.5;
     let f = fract(p);
     let base = floor(p);
-    let x0 = texel_index(base.x, info.width, mode_u);
-    let x1 = texel_index(base.x + 1.0, info.width, mode_u);
-    let y0 = texel_index(base.y, info.height, mode_v);
-    let y1 = texel_index(base.y + 1.0, info.height, mode_v);
-    let top = mix(texel(info, x0, y0), texel(info, x1, y0), f.x);
-    let bottom = mix(texel(info, x0, y1), texel(info, x1, y1), f.x);
+    let x0 = texel_index(base.x, slot.width, mode_u);
+    let x1 = texel_index(base.x + 1.0, slot.width, mode_u);
+    let y0 = texel_index(base.y, slot.height, mode_v);
+    let y1 = texel_index(base.y + 1.0, slot.height, mode_v);
+    let top = mix(texel(slot, x0, y0), texel(slot, x1, y0), f.x);
+    let bottom = mix(texel(slot, x0, y1), texel(slot, x1, y1), f.x);
     return mix(top, bottom, f.y);
+}
+
+// Whether material `m` has its texture `which` (a TEXTURE_*).
+// CPU twin: `has_texture`.
+fn has_texture(m: Material, which: u32) -> bool {
+    return ((m.texture_mask >> which) & 1u) != 0u;
+}
+
+// Material `m`'s texture `which` (a TEXTURE_* it has) at `uv`.
+// CPU twin: `material_texture`.
+fn material_texture(m: Material, which: u32, uv: vec2f) -> vec4f {
+    return sample_slot(texture_slots[m.textures + which], uv);
 }
 
 // Texture coordinates at barycentrics (b1, b2) of triangle `triangle`.
@@ -79,13 +90,13 @@ fn blend_threshold(triangle: u32, t: f32) -> f32 {
 // material has alpha holes): its alpha reaches the cutoff (MASK) or the blend threshold.
 // CPU twin: `alpha_stops`.
 fn alpha_stops(object: u32, triangle: u32, b1: f32, b2: f32, t: f32) -> bool {
-    let m = objects[object].material;
-    var alpha = materials[m].alpha_factor;
-    if materials[m].slots[SLOT_BASE].texture >= 0 {
-        alpha *= sample_slot(materials[m].slots[SLOT_BASE], triangle_uv(triangle, b1, b2)).a;
+    let m = materials[objects[object].material];
+    var alpha = m.alpha_factor;
+    if has_texture(m, TEXTURE_BASE) {
+        alpha *= material_texture(m, TEXTURE_BASE, triangle_uv(triangle, b1, b2)).a;
     }
-    if (materials[m].flags & MATERIAL_MASK) != 0u {
-        return alpha >= materials[m].alpha_cutoff;
+    if (m.flags & MATERIAL_MASK) != 0u {
+        return alpha >= m.alpha_cutoff;
     }
     return alpha > blend_threshold(triangle, t);
 }

@@ -1,0 +1,131 @@
+//! A material at a surface point, and the one dispatch on its model: the common textures
+//! (base colour, emission) applied here, the model's own texture step, BSDF evaluation and
+//! sampling in the model's module ([`crate::lobes`], [`crate::metal_rough`]). Twin of
+//! `material.wgsl`.
+
+use glam::{Vec2, Vec3A, Vec4};
+use pathlight_core::gpu_types::{TEXTURE_BASE, TEXTURE_EMISSION};
+use pathlight_core::materials::MODEL_METAL_ROUGH;
+
+use crate::cpu_scene::CpuScene;
+use crate::lobes::{LobesParams, eval_lobes, has_continuous_lobes, sample_lobes};
+use crate::metal_rough::{
+    MetalRoughParams, has_continuous_metal_rough, metal_rough_textured, sample,
+};
+use crate::microfacet::{BsdfEval, BsdfSample};
+use crate::surface::Surface;
+use crate::textures::{has_texture, material_texture, srgb_to_linear};
+
+/// Vectors of a model's parameter block the kernels load (WGSL `MODEL_PARAMS`).
+pub const MODEL_PARAMS: usize = pathlight_core::materials::MODEL_PARAMS;
+
+/// A material with its textures applied at a point: what its model's BSDF reads. Twin of
+/// WGSL `MaterialPoint`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MaterialPoint {
+    /// `MODEL_*` of `pathlight_core::materials`.
+    pub model: u32,
+    /// Base colour (texture times factor).
+    pub base_color: Vec3A,
+    /// Emitted radiance (texture times factor).
+    pub emission: Vec3A,
+    /// The model's parameter block, its texture step applied; its module decodes it.
+    pub params: [Vec4; MODEL_PARAMS],
+}
+
+/// Material `index` at texture coordinates `uv`. Twin of WGSL `material_at`.
+#[inline(always)]
+pub fn material_at(scene: &CpuScene, index: u32, uv: Vec2) -> MaterialPoint {
+    let m = &scene.materials[index as usize];
+    let first = m.params as usize;
+    let mut params: [Vec4; MODEL_PARAMS] =
+        std::array::from_fn(|i| Vec4::from_array(scene.material_params[first + i]));
+    let mut base_color = Vec3A::from(m.base_color);
+    if has_texture(m, TEXTURE_BASE) {
+        let texel = material_texture(scene, m, TEXTURE_BASE, uv)
+            .truncate()
+            .into();
+        base_color = Vec3A::from(m.base_color) * srgb_to_linear(texel);
+    }
+    if m.model == MODEL_METAL_ROUGH {
+        metal_rough_textured(scene, &mut params, m, uv);
+    }
+    MaterialPoint {
+        model: m.model,
+        base_color,
+        emission: emission_at(scene, index, uv),
+        params,
+    }
+}
+
+/// The radiance material `index` emits at `uv` (its front side). Twin of WGSL
+/// `emission_at`.
+#[inline(always)]
+pub fn emission_at(scene: &CpuScene, index: u32, uv: Vec2) -> Vec3A {
+    let m = &scene.materials[index as usize];
+    let emission = Vec3A::from(m.emission);
+    if has_texture(m, TEXTURE_EMISSION) {
+        let texel = material_texture(scene, m, TEXTURE_EMISSION, uv)
+            .truncate()
+            .into();
+        return emission * srgb_to_linear(texel);
+    }
+    emission
+}
+
+/// `f * |cos_i|` of the non-delta part of the BSDF and the density with which
+/// [`sample_material`] produces `wi`. Twin of WGSL `eval_material`. (Here and below, the
+/// last arm is `MODEL_LOBES`.)
+#[inline(always)]
+pub fn eval_material(p: &MaterialPoint, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfEval {
+    match p.model {
+        MODEL_METAL_ROUGH => crate::metal_rough::eval(
+            &MetalRoughParams::decode(&p.params),
+            p.base_color,
+            s,
+            wo,
+            wi,
+        ),
+        _ => eval_lobes(&LobesParams::decode(&p.params), p.base_color, s, wo, wi),
+    }
+}
+
+/// A direction sampled from the BSDF. Twin of WGSL `sample_material`.
+#[inline(always)]
+pub fn sample_material(
+    p: &MaterialPoint,
+    s: &Surface,
+    wo: Vec3A,
+    u_lobe: f32,
+    u_fresnel: f32,
+    u: Vec2,
+) -> BsdfSample {
+    let color = p.base_color;
+    match p.model {
+        MODEL_METAL_ROUGH => {
+            let m = MetalRoughParams::decode(&p.params);
+            sample(&m, color, s, wo, u_lobe, u_fresnel, u)
+        }
+        _ => sample_lobes(
+            &LobesParams::decode(&p.params),
+            color,
+            s,
+            wo,
+            u_lobe,
+            u_fresnel,
+            u,
+        ),
+    }
+}
+
+/// Whether the BSDF has a non-delta lobe (next-event estimation is worth doing). Twin of
+/// WGSL `has_continuous_material_lobe`.
+#[inline(always)]
+pub fn has_continuous_material_lobe(p: &MaterialPoint) -> bool {
+    match p.model {
+        MODEL_METAL_ROUGH => {
+            has_continuous_metal_rough(&MetalRoughParams::decode(&p.params), p.base_color)
+        }
+        _ => has_continuous_lobes(&LobesParams::decode(&p.params)),
+    }
+}

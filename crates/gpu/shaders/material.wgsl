@@ -1,0 +1,98 @@
+// A material at a surface point, and the one dispatch on its model: the common textures
+// (base colour, emission) applied here, the model's own texture step, BSDF evaluation and
+// sampling in the model's file (`lobes.wgsl`, `metal_rough.wgsl`). A new model adds a
+// MODEL_ constant and a case to each switch below (ARCHITECTURE.md, "How to add a material
+// model"). CPU twin: `crates/cpu/src/material.rs`.
+
+#import scene
+#import textures
+#import surface
+#import microfacet
+#import lobes
+#import metal_rough
+
+// `Material.model` (host: `pathlight_core::materials`).
+const MODEL_LOBES: u32 = 0u;
+const MODEL_METAL_ROUGH: u32 = 1u;
+
+// A material with its textures applied at a point: what its model's BSDF reads.
+// CPU twin: `MaterialPoint`.
+struct MaterialPoint {
+    model: u32,
+    // Base colour (texture times factor).
+    base_color: vec3f,
+    // Emitted radiance (texture times factor).
+    emission: vec3f,
+    // The model's parameter block, its texture step applied; its file decodes it.
+    params: array<vec4f, MODEL_PARAMS>,
+}
+
+// Material `index` at texture coordinates `uv`.
+// CPU twin: `material_at`.
+fn material_at(index: u32, uv: vec2f) -> MaterialPoint {
+    let m = materials[index];
+    // Loaded with constant indices (MODEL_PARAMS of them): an array indexed at run time
+    // would be kept in memory rather than in registers.
+    var params = array<vec4f, MODEL_PARAMS>(material_params[m.params], material_params[m.params + 1u], material_params[m.params + 2u], material_params[m.params + 3u]);
+    var base_color = m.base_color;
+    if has_texture(m, TEXTURE_BASE) {
+        base_color = m.base_color * srgb_to_linear(material_texture(m, TEXTURE_BASE, uv).rgb);
+    }
+    switch m.model {
+        case MODEL_METAL_ROUGH: {
+            metal_rough_textured(&params, m, uv);
+        }
+        default: {}
+    }
+    return MaterialPoint(m.model, base_color, emission_at(index, uv), params);
+}
+
+// The radiance material `index` emits at `uv` (its front side).
+// CPU twin: `emission_at`.
+fn emission_at(index: u32, uv: vec2f) -> vec3f {
+    let m = materials[index];
+    if has_texture(m, TEXTURE_EMISSION) {
+        return m.emission * srgb_to_linear(material_texture(m, TEXTURE_EMISSION, uv).rgb);
+    }
+    return m.emission;
+}
+
+// f * |cos_i| of the non-delta part of the BSDF and the density with which
+// `sample_material` produces wi.
+// CPU twin: `eval_material`.
+fn eval_material(p: MaterialPoint, s: Surface, wo: vec3f, wi: vec3f) -> BsdfEval {
+    switch p.model {
+        case MODEL_METAL_ROUGH: {
+            return eval_metal_rough(metal_rough_params(p.params), p.base_color, s, wo, wi);
+        }
+        default: {
+            return eval_lobes(lobes_params(p.params), p.base_color, s, wo, wi);
+        }
+    }
+}
+
+// A direction sampled from the BSDF.
+// CPU twin: `sample_material`.
+fn sample_material(p: MaterialPoint, s: Surface, wo: vec3f, u_lobe: f32, u_fresnel: f32, u: vec2f) -> BsdfSample {
+    switch p.model {
+        case MODEL_METAL_ROUGH: {
+            return sample_metal_rough(metal_rough_params(p.params), p.base_color, s, wo, u_lobe, u_fresnel, u);
+        }
+        default: {
+            return sample_lobes(lobes_params(p.params), p.base_color, s, wo, u_lobe, u_fresnel, u);
+        }
+    }
+}
+
+// Whether the BSDF has a non-delta lobe (next-event estimation is worth doing).
+// CPU twin: `has_continuous_material_lobe`.
+fn has_continuous_material_lobe(p: MaterialPoint) -> bool {
+    switch p.model {
+        case MODEL_METAL_ROUGH: {
+            return has_continuous_metal_rough(metal_rough_params(p.params), p.base_color);
+        }
+        default: {
+            return has_continuous_lobes(lobes_params(p.params));
+        }
+    }
+}

@@ -1,0 +1,329 @@
+//! Building a [`Scene`] from scene-file text: validation, name resolution, asset loading.
+//! The camera, settings and environment are read here, the materials in [`materials`], the
+//! shapes and placed glTF files in [`objects`].
+
+mod materials;
+mod objects;
+
+use std::collections::HashMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::Vec3;
+use toml::Spanned;
+
+use crate::desc::{EnvironmentDesc, RenderDesc, SamplerDesc, SceneDesc};
+use crate::error::SceneError;
+use crate::settings::{MAX_COORDINATE, check_max_depth, check_resolution, check_spp};
+use crate::{Camera, Environment, HdrImage, RenderSettings, Sampler, Scene, Texture};
+
+/// Where a scene's text and assets come from.
+#[derive(Debug, Clone)]
+pub struct SceneSource<'a> {
+    /// Name used in error messages (usually the file path).
+    pub name: String,
+    /// The TOML text.
+    pub text: &'a str,
+    /// Directory that relative asset paths start from.
+    pub base_dir: PathBuf,
+    /// Assets compiled into the binary, by the path the scene names them with.
+    pub embedded: &'a [(&'a str, &'a [u8])],
+}
+
+/// Reads and builds the scene in `path`.
+pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
+    load_scene(&SceneSource {
+        name: path.display().to_string(),
+        text: &text,
+        base_dir: path.parent().map(Path::to_owned).unwrap_or_default(),
+        embedded: &[],
+    })
+}
+
+/// Parses and builds a scene.
+pub fn load_scene(source: &SceneSource) -> Result<Scene, SceneError> {
+    let desc: SceneDesc = toml::from_str(source.text).map_err(|err| {
+        let (line, column) = err
+            .span()
+            .map(|span| line_column(source.text, span.start))
+            .unwrap_or((1, 1));
+        SceneError::Syntax {
+            file: source.name.clone(),
+            line,
+            column,
+            message: err.message().trim().to_owned(),
+        }
+    })?;
+    Builder {
+        source,
+        textures: Vec::new(),
+        texture_ids: HashMap::new(),
+    }
+    .build(desc)
+}
+
+/// 1-based line and column of a byte offset.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+    (line, column)
+}
+
+struct Builder<'a, 'b> {
+    source: &'a SceneSource<'b>,
+    textures: Vec<Texture>,
+    texture_ids: HashMap<String, u32>,
+}
+
+impl Builder<'_, '_> {
+    fn invalid(&self, span: Range<usize>, message: String) -> SceneError {
+        SceneError::Invalid {
+            file: self.source.name.clone(),
+            line: line_column(self.source.text, span.start).0,
+            message,
+        }
+    }
+
+    fn build(mut self, desc: SceneDesc) -> Result<Scene, SceneError> {
+        let camera = self.camera(&desc)?;
+        let settings = self.settings(&desc)?;
+        let environment = match &desc.environment {
+            None => Environment::default(),
+            Some(env) => self.environment(env)?,
+        };
+        let mut materials = Vec::new();
+        let mut material_ids = HashMap::new();
+        for (name, material) in &desc.materials {
+            material_ids.insert(name.clone(), materials.len() as u32);
+            materials.push(self.material(name, material, desc.color_space)?);
+        }
+        let mut objects = self.objects(&desc, &material_ids)?;
+        for gltf in &desc.gltf {
+            self.place_gltf(gltf, &mut materials, &mut objects)?;
+        }
+        Ok(Scene {
+            camera,
+            settings,
+            environment,
+            materials,
+            textures: self.textures,
+            objects,
+        })
+    }
+
+    fn camera(&self, desc: &SceneDesc) -> Result<Camera, SceneError> {
+        let span = desc.camera.span();
+        let c = desc.camera.get_ref();
+        let position = self.point(span.clone(), "camera.position", c.position)?;
+        let look_at = self.point(span.clone(), "camera.look_at", c.look_at)?;
+        let up = self.point(span.clone(), "camera.up", c.up)?;
+        if position.distance(look_at) <= 0.0 {
+            return Err(self.invalid(span, "camera.look_at equals camera.position".into()));
+        }
+        if up.cross(look_at - position).length_squared() <= 0.0 {
+            return Err(self.invalid(span, "camera.up is parallel to the view direction".into()));
+        }
+        if !(c.fov_y > 0.0 && c.fov_y < 180.0) {
+            return Err(self.invalid(
+                span,
+                format!(
+                    "camera.fov_y = {} must lie strictly between 0 and 180 degrees",
+                    c.fov_y
+                ),
+            ));
+        }
+        let [width, height] = c.resolution;
+        check_resolution(width, height).map_err(|e| self.invalid(span.clone(), e.to_string()))?;
+        if !(c.aperture_radius >= 0.0 && c.aperture_radius <= MAX_COORDINATE) {
+            return Err(self.invalid(
+                span,
+                format!(
+                    "camera.aperture_radius = {} must be >= 0 and at most {MAX_COORDINATE:e}",
+                    c.aperture_radius
+                ),
+            ));
+        }
+        let focus_distance = match c.focus_distance {
+            Some(d) => self.length(span, "camera.focus_distance", d)?,
+            None => position.distance(look_at),
+        };
+        Ok(Camera {
+            position,
+            look_at,
+            up,
+            fov_y_deg: c.fov_y,
+            width,
+            height,
+            aperture_radius: c.aperture_radius,
+            focus_distance,
+        })
+    }
+
+    /// `[environment]`: a constant `radiance` or a `map` with its `strength` and `rotation`.
+    fn environment(&self, env: &Spanned<EnvironmentDesc>) -> Result<Environment, SceneError> {
+        let (span, e) = (env.span(), env.get_ref());
+        let key = |k: &str| format!("environment.{k}");
+        match (&e.radiance, &e.map) {
+            (Some(radiance), None) => {
+                if e.strength.is_some() || e.rotation.is_some() {
+                    return Err(self.invalid(
+                        span,
+                        "environment.strength and environment.rotation apply to a `map`".into(),
+                    ));
+                }
+                Ok(Environment::Constant(self.radiance(
+                    span,
+                    &key("radiance"),
+                    *radiance,
+                )?))
+            }
+            (None, Some(path)) => {
+                let strength = e.strength.unwrap_or(1.0);
+                if !(strength.is_finite() && strength >= 0.0) {
+                    return Err(self.invalid(
+                        span,
+                        format!("{} = {strength} must be finite and >= 0", key("strength")),
+                    ));
+                }
+                let rotation = e.rotation.unwrap_or(0.0);
+                if !rotation.is_finite() {
+                    return Err(self.invalid(
+                        span,
+                        format!("{} = {rotation} must be finite", key("rotation")),
+                    ));
+                }
+                let (full, bytes) = self.asset_bytes(path).map_err(|err| match err {
+                    SceneError::Io { path, source } => self.invalid(
+                        span.clone(),
+                        format!("{}: cannot read {}: {source}", key("map"), path.display()),
+                    ),
+                    other => other,
+                })?;
+                let image = HdrImage::decode(&bytes, &full)?;
+                Ok(Environment::from_map(Arc::new(image), strength, rotation))
+            }
+            _ => Err(self.invalid(
+                span,
+                "[environment] needs exactly one of `radiance` (a constant) and `map` (an image)"
+                    .into(),
+            )),
+        }
+    }
+
+    fn settings(&self, desc: &SceneDesc) -> Result<RenderSettings, SceneError> {
+        let Some(render) = &desc.render else {
+            return Ok(RenderSettings::from(&RenderDesc::default()));
+        };
+        let span = render.span();
+        let r = render.get_ref();
+        check_spp(r.spp).map_err(|e| self.invalid(span.clone(), e.to_string()))?;
+        check_max_depth(r.max_depth).map_err(|e| self.invalid(span, e.to_string()))?;
+        Ok(RenderSettings::from(r))
+    }
+
+    fn point(&self, span: Range<usize>, key: &str, v: [f32; 3]) -> Result<Vec3, SceneError> {
+        if v.iter().all(|c| c.abs() <= MAX_COORDINATE) {
+            Ok(Vec3::from(v))
+        } else {
+            Err(self.invalid(
+                span,
+                format!(
+                    "{key} = {v:?}: coordinates must be finite and within +-{MAX_COORDINATE:e}"
+                ),
+            ))
+        }
+    }
+
+    /// A length (a radius): finite, above zero and within the coordinate limit.
+    fn length(&self, span: Range<usize>, key: &str, value: f32) -> Result<f32, SceneError> {
+        if value > 0.0 && value <= MAX_COORDINATE {
+            Ok(value)
+        } else {
+            Err(self.invalid(
+                span,
+                format!("{key} = {value} must be > 0 and at most {MAX_COORDINATE:e}"),
+            ))
+        }
+    }
+
+    fn radiance(&self, span: Range<usize>, key: &str, v: [f32; 3]) -> Result<Vec3, SceneError> {
+        if v.iter().all(|c| c.is_finite() && *c >= 0.0) {
+            Ok(Vec3::from(v))
+        } else {
+            Err(self.invalid(span, format!("{key} = {v:?} must be finite and >= 0")))
+        }
+    }
+
+    fn unit(&self, span: Range<usize>, key: &str, value: f32) -> Result<f32, SceneError> {
+        if (0.0..=1.0).contains(&value) {
+            Ok(value)
+        } else {
+            Err(self.invalid(span, format!("{key} = {value} must lie in [0, 1]")))
+        }
+    }
+
+    /// Reads an asset named in the file: embedded first, else relative to the scene.
+    fn asset_bytes(&self, path: &str) -> Result<(PathBuf, Vec<u8>), SceneError> {
+        if let Some((_, bytes)) = self.source.embedded.iter().find(|(name, _)| *name == path) {
+            return Ok((PathBuf::from(path), bytes.to_vec()));
+        }
+        let full = self.source.base_dir.join(path);
+        let bytes = std::fs::read(&full).map_err(|source| SceneError::Io {
+            path: full.clone(),
+            source,
+        })?;
+        Ok((full, bytes))
+    }
+
+    fn texture(&mut self, span: Range<usize>, key: &str, path: &str) -> Result<u32, SceneError> {
+        if let Some(&id) = self.texture_ids.get(path) {
+            return Ok(id);
+        }
+        let (full, bytes) = self.asset_bytes(path).map_err(|err| match err {
+            SceneError::Io { path, source } => self.invalid(
+                span,
+                format!("{key}: cannot read {}: {source}", path.display()),
+            ),
+            other => other,
+        })?;
+        let texture = Texture::decode(&bytes, &full)?;
+        let id = self.textures.len() as u32;
+        self.textures.push(texture);
+        self.texture_ids.insert(path.to_owned(), id);
+        Ok(id)
+    }
+}
+
+impl From<&RenderDesc> for RenderSettings {
+    fn from(r: &RenderDesc) -> Self {
+        Self {
+            spp: r.spp,
+            max_depth: r.max_depth,
+            rr_depth: r.rr_depth,
+            seed: r.seed,
+            sampler: match r.sampler {
+                SamplerDesc::Sobol => Sampler::Sobol,
+                SamplerDesc::Independent => Sampler::Independent,
+            },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::line_column;
+
+    #[test]
+    fn line_column_counts_from_one() {
+        let text = "a\nbc\nd";
+        assert_eq!(line_column(text, 0), (1, 1));
+        assert_eq!(line_column(text, 3), (2, 2));
+        assert_eq!(line_column(text, 5), (3, 1));
+    }
+}
