@@ -8,7 +8,10 @@ use pathlight_core::{PreparedScene, Renderer};
 use pathlight_cpu::{CpuRenderer, InstructionSet};
 use pathlight_gpu::context::{AutoChoice, auto_choice, available_adapters, describe};
 use pathlight_gpu::{Accel, GpuContext, GpuRenderer};
-use pathlight_scene::settings::{check_max_depth, check_resolution};
+use pathlight_scene::settings::{
+    check_aperture, check_env_rotation, check_env_strength, check_length, check_max_depth,
+    check_resolution,
+};
 use pathlight_scene::{
     Environment, HdrImage, Sampler, Scene, default_scene, gltf_scene, load_scene_file,
 };
@@ -62,16 +65,10 @@ fn is_gltf(path: &std::path::Path) -> bool {
 /// `--env`, `--env-strength` and `--env-rotation`.
 fn apply_environment(scene: &mut Scene, args: &SceneArgs) -> anyhow::Result<()> {
     if let Some(strength) = args.env_strength {
-        anyhow::ensure!(
-            strength.is_finite() && strength >= 0.0,
-            "--env-strength {strength} must be finite and >= 0"
-        );
+        check_env_strength("--env-strength", strength)?;
     }
     if let Some(rotation) = args.env_rotation {
-        anyhow::ensure!(
-            rotation.is_finite(),
-            "--env-rotation {rotation} must be finite"
-        );
+        check_env_rotation("--env-rotation", rotation)?;
     }
     if args.env.is_none() && args.env_strength.is_none() && args.env_rotation.is_none() {
         return Ok(());
@@ -99,18 +96,10 @@ fn apply_environment(scene: &mut Scene, args: &SceneArgs) -> anyhow::Result<()> 
 /// `--aperture` and `--focus-distance`.
 fn apply_lens(scene: &mut Scene, args: &SceneArgs) -> anyhow::Result<()> {
     if let Some(radius) = args.aperture {
-        anyhow::ensure!(
-            radius.is_finite() && radius >= 0.0,
-            "--aperture {radius} must be finite and >= 0"
-        );
-        scene.camera.aperture_radius = radius;
+        scene.camera.aperture_radius = check_aperture("--aperture", radius)?;
     }
     if let Some(distance) = args.focus_distance {
-        anyhow::ensure!(
-            distance.is_finite() && distance > 0.0,
-            "--focus-distance {distance} must be finite and > 0"
-        );
-        scene.camera.focus_distance = distance;
+        scene.camera.focus_distance = check_length("--focus-distance", distance)?;
     }
     Ok(())
 }

@@ -90,16 +90,17 @@ fn start(scene: &Scene, args: &RenderArgs, fingerprint: &Fingerprint) -> anyhow:
         let accumulation = state
             .accumulation()
             .with_context(|| format!("cannot resume {}", path.display()))?;
-        let rendered = accumulation.first_sample + accumulation.samples;
+        let cursor = accumulation.cursor;
+        let rendered = cursor.next_sample();
         let end = match args.spp {
             Some(spp) => spp,
             None => state.target.end,
         };
-        if end < rendered + u32::from(accumulation.rows_ahead > 0) {
+        if end < rendered + u32::from(cursor.in_pass()) {
             bail!(
                 "cannot resume {} to {end} spp: it holds samples {}..{rendered} already",
                 path.display(),
-                accumulation.first_sample
+                cursor.first_sample
             );
         }
         return Ok(Start {
@@ -165,13 +166,13 @@ fn render_to_file(
         Device::Cpu => "backend",
     };
     note!("{kind}: {}", renderer.device());
-    let first_sample = accumulation.first_sample;
+    let first_sample = accumulation.cursor.first_sample;
     renderer.resume(&accumulation)?;
     let total = target.end - first_sample;
-    if accumulation.samples > 0 {
+    if accumulation.cursor.samples > 0 {
         note!(
             "resuming at sample {} of {}..{}",
-            first_sample + accumulation.samples,
+            accumulation.cursor.next_sample(),
             target.start,
             target.end
         );

@@ -558,11 +558,20 @@ fn env_and_lens_options_replace_the_scenes() {
         ),
         (
             vec!["--aperture", "-1"],
-            vec!["--aperture -1 must be finite and >= 0"],
+            vec!["--aperture = -1 must be >= 0 and at most 1e15"],
+        ),
+        // The limits a scene file's lens is held to (one check serves both).
+        (
+            vec!["--aperture", "1e30"],
+            vec!["--aperture = 1000000000000000000000000000000 must be >= 0 and at most 1e15"],
         ),
         (
             vec!["--focus-distance", "0"],
-            vec!["--focus-distance 0 must be finite and > 0"],
+            vec!["--focus-distance = 0 must be > 0 and at most 1e15"],
+        ),
+        (
+            vec!["--env-strength", "-2"],
+            vec!["--env-strength = -2 must be finite and >= 0"],
         ),
     ] {
         let mut all = vec!["render", "scenes/refs/furnace-0.8.toml"];

@@ -1,8 +1,8 @@
 //! The rendered image: mean linear radiance per pixel, made from either backend's running
 //! sums, read from and written to OpenEXR, and compared with a reference.
 
+use crate::accumulation::{Accumulation, SampleCursor};
 use crate::gpu_types::GpuAccumPixel;
-use crate::renderer::Accumulation;
 
 /// Mean linear RGB radiance per pixel, row 0 at the top.
 #[derive(Debug, Clone, PartialEq)]
@@ -18,31 +18,21 @@ pub struct Film {
 }
 
 impl Film {
-    /// The mean of fixed-point sums ([`GpuAccumPixel`], both backends accumulate them) of
-    /// `spp` samples per pixel, where rows `0 .. rows_ahead` (a pass in progress) hold one
-    /// sample more.
+    /// The mean of fixed-point sums ([`GpuAccumPixel`], both backends accumulate them) of a
+    /// `width` x `height` image holding the samples `cursor` says.
     pub fn from_fixed_point(
         width: u32,
         height: u32,
-        spp: u32,
-        rows_ahead: u32,
+        cursor: &SampleCursor,
         sums: &[GpuAccumPixel],
     ) -> Self {
-        let counts: Vec<u32> = (0..height)
-            .map(|y| spp + u32::from(y < rows_ahead))
-            .collect();
+        let counts: Vec<u32> = (0..height).map(|y| cursor.row_samples(y)).collect();
         Self::from_row_sums(width, &counts, sums)
     }
 
     /// The image of a render's accumulation.
     pub fn from_accumulation(width: u32, height: u32, accumulation: &Accumulation) -> Self {
-        Self::from_fixed_point(
-            width,
-            height,
-            accumulation.samples,
-            accumulation.rows_ahead,
-            &accumulation.sums,
-        )
+        Self::from_fixed_point(width, height, &accumulation.cursor, &accumulation.sums)
     }
 
     /// The mean of fixed-point sums, row by row, where row `y` holds `counts[y]` samples per

@@ -65,22 +65,28 @@ pub struct GpuObject {
 }
 const _: () = assert!(size_of::<GpuObject>() == 80);
 
-/// One emitter a path can sample: a whole quad, sphere or cylinder, or one triangle of an
-/// emissive mesh, chosen with probability proportional to its power. WGSL: `Light`.
+/// [`GpuLight::kind`] of an emissive quad, sphere or cylinder, or one triangle of an
+/// emissive mesh (`area_light.wgsl`).
+pub const LIGHT_AREA: u32 = 0;
+
+/// One entry of the light table, chosen with probability proportional to its power: a light
+/// of type `kind` (a `LIGHT_*`; its file in the kernels samples it). WGSL: `Light`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuLight {
-    /// Index into the object buffer.
-    pub object: u32,
-    /// Triangle index for a mesh light, 0 otherwise.
+    /// `LIGHT_*`.
+    pub kind: u32,
+    /// [`LIGHT_AREA`]: index into the object buffer.
+    pub index: u32,
+    /// [`LIGHT_AREA`]: the triangle of a mesh, 0 for a whole shape.
     pub primitive: u32,
-    /// Probability of choosing a light up to and including this one (among the shape
+    /// Probability of choosing a light up to and including this one (among the table's
     /// lights; the environment is chosen first with `env_pmf`).
     pub cdf: f32,
-    /// Probability of choosing this light among the shape lights.
+    /// Probability of choosing this light among the table's.
     pub pmf: f32,
 }
-const _: () = assert!(size_of::<GpuLight>() == 16);
+const _: () = assert!(size_of::<GpuLight>() == 20);
 
 /// One node of the 4-wide BVH both backends walk ([`crate::geometry::Geometry::nodes`]): its
 /// four children's boxes in structure-of-arrays form, and what each child is. Aligned to 16

@@ -3,6 +3,7 @@
 //! as WGSL declares them), the per-render constants (camera, settings), the film, and the
 //! interface both backends implement ([`Renderer`]). Nothing here depends on wgpu.
 
+pub mod accumulation;
 pub mod bvh;
 pub mod camera;
 pub mod environment;
@@ -21,12 +22,13 @@ pub mod state;
 pub mod textures;
 pub mod tonemap;
 
+pub use accumulation::{Accumulation, SampleCursor};
 pub use environment::EnvironmentData;
 pub use error::{GeometryError, RenderError};
 pub use film::Film;
 pub use geometry::Geometry;
 pub use prepared::PreparedScene;
-pub use renderer::{Accumulation, Renderer};
+pub use renderer::Renderer;
 pub use shading::Shading;
 pub use textures::Textures;
 pub use tonemap::ToneMap;

@@ -9,7 +9,7 @@ use glam::Vec3;
 use crate::geometry::Geometry;
 use crate::gpu_types::{
     FLAG_CAPS, GpuLight, GpuObject, GpuVertex, KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE,
-    NO_LIGHT,
+    LIGHT_AREA, NO_LIGHT,
 };
 
 /// Luminance of linear RGB (Rec. 709 weights): what emitters and environment-map cells are
@@ -71,7 +71,8 @@ pub fn build(
         for primitive in primitives {
             powers.push(emitter_area(object, &geometry.vertices, primitive) * luminance);
             lights.push(GpuLight {
-                object: i as u32,
+                kind: LIGHT_AREA,
+                index: i as u32,
                 primitive,
                 cdf: 0.0,
                 pmf: 0.0,
@@ -106,7 +107,7 @@ mod tests {
     use pathlight_scene::testing::{mesh_of, object, scene_of};
     use pathlight_scene::{Material, Scene, Shape};
 
-    use crate::gpu_types::NO_LIGHT;
+    use crate::gpu_types::{LIGHT_AREA, NO_LIGHT};
     use crate::{Geometry, Shading, Textures};
 
     /// A scene whose material 1 emits `emission`, with a 2x1 quad, a sphere of radius 0.5
@@ -180,7 +181,7 @@ mod tests {
         }
         assert_eq!(lights[3].cdf, 1.0);
         for (i, o) in shading.objects[..3].iter().enumerate() {
-            assert_eq!(shading.lights[o.light as usize].object, i as u32);
+            assert_eq!(shading.lights[o.light as usize].index, i as u32);
         }
         assert_eq!(shading.objects[3].light, NO_LIGHT);
         // A mesh's entries follow its triangles in the vertex buffer.
@@ -188,8 +189,8 @@ mod tests {
         for t in 0..mesh.triangle_count {
             let entry = shading.lights[(mesh.light + t) as usize];
             assert_eq!(
-                (entry.object, entry.primitive),
-                (2, mesh.first_triangle + t)
+                (entry.kind, entry.index, entry.primitive),
+                (LIGHT_AREA, 2, mesh.first_triangle + t)
             );
         }
     }

@@ -5,56 +5,10 @@ use std::time::Duration;
 
 use pathlight_scene::Camera;
 
+use crate::accumulation::Accumulation;
 use crate::error::RenderError;
 use crate::film::Film;
-use crate::gpu_types::GpuAccumPixel;
 use crate::shading::Shading;
-
-/// A render's running sums with the samples they hold: what a checkpoint keeps, what a
-/// shard hands over, and what a render resumes from.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Accumulation {
-    /// Index of every pixel's first sample.
-    pub first_sample: u32,
-    /// Whole passes (samples of every pixel) since the first sample.
-    pub samples: u32,
-    /// Rows `0 .. rows_ahead` hold one sample more (a pass in progress).
-    pub rows_ahead: u32,
-    /// The fixed-point sums, row by row.
-    pub sums: Vec<GpuAccumPixel>,
-}
-
-impl Accumulation {
-    /// No sample yet: the image empty, its first sample `first_sample`.
-    pub fn empty(width: u32, height: u32, first_sample: u32) -> Self {
-        Self {
-            first_sample,
-            samples: 0,
-            rows_ahead: 0,
-            sums: vec![GpuAccumPixel::default(); (width * height) as usize],
-        }
-    }
-
-    /// Refuses sums that do not fit a `width` x `height` image.
-    pub fn check_fits(&self, width: u32, height: u32) -> Result<(), RenderError> {
-        let pixels = width as usize * height as usize;
-        if self.sums.len() != pixels || (self.rows_ahead > 0 && self.rows_ahead >= height) {
-            return Err(RenderError::Resume(format!(
-                "{} sums with {} rows ahead do not fit a {width}x{height} image",
-                self.sums.len(),
-                self.rows_ahead
-            )));
-        }
-        if u64::from(self.first_sample) + u64::from(self.samples) + 1 > u64::from(u32::MAX) {
-            return Err(RenderError::Resume(format!(
-                "samples {}..{} run past the last sample index",
-                self.first_sample,
-                u64::from(self.first_sample) + u64::from(self.samples)
-            )));
-        }
-        Ok(())
-    }
-}
 
 /// A progressive render: samples are added to every pixel in turn, and the image at any
 /// moment is the mean of the samples so far. Sample `i` of a pixel is the same whatever
@@ -113,7 +67,7 @@ pub trait Renderer {
     fn accumulation(&self) -> Result<Accumulation, RenderError>;
 
     /// Replaces the image with `from`: the next pass renders sample
-    /// `from.first_sample + from.samples` of every pixel (rows `0 .. from.rows_ahead`
+    /// `from.cursor.next_sample()` of every pixel (rows `0 .. from.cursor.rows_ahead`
     /// already hold it), so that a render resumed from its own accumulation goes on exactly
     /// as if it had never stopped. The ray and dropped-sample counts start over.
     fn resume(&mut self, from: &Accumulation) -> Result<(), RenderError>;

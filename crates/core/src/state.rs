@@ -9,10 +9,10 @@ use pathlight_scene::{Camera, RenderSettings, Sampler};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 
+use crate::accumulation::{Accumulation, SampleCursor};
 use crate::film::Film;
 use crate::gpu_types::{GpuAccumPixel, GpuCamera};
 use crate::prepared::PreparedScene;
-use crate::renderer::Accumulation;
 
 /// The first bytes of every state file.
 pub const MAGIC: &[u8; 16] = b"pathlight-state\n";
@@ -185,12 +185,10 @@ impl RenderState {
         backend: String,
         accumulation: Accumulation,
     ) -> Self {
-        let first = accumulation.first_sample;
+        let cursor = accumulation.cursor;
+        let first = cursor.first_sample;
         let rows = (0..fingerprint.height)
-            .map(|y| {
-                let count = accumulation.samples + u32::from(y < accumulation.rows_ahead);
-                first..first + count
-            })
+            .map(|y| first..first + cursor.row_samples(y))
             .collect();
         Self {
             fingerprint,
@@ -234,9 +232,11 @@ impl RenderState {
             ));
         }
         Ok(Accumulation {
-            first_sample: first,
-            samples: last - first,
-            rows_ahead: ahead as u32,
+            cursor: SampleCursor {
+                first_sample: first,
+                samples: last - first,
+                rows_ahead: ahead as u32,
+            },
             sums: self.sums.clone(),
         })
     }
@@ -504,9 +504,11 @@ mod tests {
             })
             .collect();
         let accumulation = Accumulation {
-            first_sample: first,
-            samples,
-            rows_ahead,
+            cursor: SampleCursor {
+                first_sample: first,
+                samples,
+                rows_ahead,
+            },
             sums,
         };
         RenderState::new(fingerprint(3, 2), target, "test".into(), accumulation)
@@ -567,9 +569,9 @@ mod tests {
         let accumulation = original.accumulation().unwrap();
         assert_eq!(
             (
-                accumulation.first_sample,
-                accumulation.samples,
-                accumulation.rows_ahead
+                accumulation.cursor.first_sample,
+                accumulation.cursor.samples,
+                accumulation.cursor.rows_ahead
             ),
             (4, 3, 1)
         );
@@ -597,7 +599,10 @@ mod tests {
         assert_eq!(merged.missing, [(1..2, 9..10)], "row 1 lacks sample 9");
         assert_eq!(merged.film().pixel(0, 0), [1.25; 3]);
         let accumulation = merged.into_state().unwrap().accumulation().unwrap();
-        assert_eq!((accumulation.samples, accumulation.rows_ahead), (9, 1));
+        assert_eq!(
+            (accumulation.cursor.samples, accumulation.cursor.rows_ahead),
+            (9, 1)
+        );
 
         // Overlap.
         let err = merge(&named(vec![

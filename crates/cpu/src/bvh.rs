@@ -2,7 +2,7 @@
 //! explicit stack. Twin of `bvh.wgsl` (its primitive tests are the same functions, so the
 //! hits are the same; only the order of the walk differs, which can change the answer
 //! between two primitives at exactly the same distance). [`crate::packet`] walks packets
-//! of rays through the same tree.
+//! of rays through the same tree; [`crate::tracer`] holds both walks' stacks for a thread.
 
 use glam::{Vec3, Vec4};
 use pathlight_core::gpu_types::{
@@ -14,7 +14,6 @@ use crate::intersect::{
     ROBUST_FAR, Ray, ShearedRay, intersect_cylinder, intersect_quad, intersect_sphere,
     intersect_triangle, safe_inverse,
 };
-use crate::packet::Lanes;
 use crate::textures::alpha_stops;
 
 /// The nearest hit of a ray. Twin of WGSL `Hit`.
@@ -158,62 +157,30 @@ impl CpuScene<'_> {
     }
 }
 
-/// Ray queries from one thread against a scene, one ray at a time or in
-/// packets ([`crate::packet`]). It keeps the traversal stacks that every query reuses, so
-/// that queries allocate nothing once they have grown to the tree's needs, and so that the
-/// whole walk inlines into the caller (compiled for its instruction set).
-#[derive(Debug, Clone)]
-pub struct Tracer<'a> {
-    /// The scene and its tree.
-    pub scene: &'a CpuScene<'a>,
-    /// The single-ray walk's stack.
-    pub(crate) stack: Vec<Entry>,
-    /// The packet walk's stack: nodes and the rays that entered them.
-    pub(crate) packet_stack: Vec<(u32, Lanes)>,
-}
-
-impl<'a> Tracer<'a> {
-    /// Queries against `scene`.
-    pub fn new(scene: &'a CpuScene<'a>) -> Self {
-        Self {
+/// Nearest hit of `ray` in `(0, t_max)` in `scene`, or with `any_hit` the first one found,
+/// walking with `stack` (emptied first). Twin of WGSL `trace_scene`.
+#[inline(always)]
+pub(crate) fn trace_scene(
+    scene: &CpuScene,
+    stack: &mut Vec<Entry>,
+    ray: &Ray,
+    t_max: f32,
+    any_hit: bool,
+) -> Hit {
+    let mut hit = Hit::none(t_max);
+    if !scene.primitives.is_empty() {
+        let lanes = RayLanes::new(ray);
+        stack.clear();
+        let walk = Walk {
             scene,
-            stack: Vec::new(),
-            packet_stack: Vec::new(),
-        }
+            ray,
+            sheared: ShearedRay::new(ray),
+            lanes: &lanes,
+            any_hit,
+        };
+        walk.tree(stack, 0, &mut hit);
     }
-
-    /// Nearest hit in `(0, t_max)`.
-    #[inline(always)]
-    pub fn intersect(&mut self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        let hit = self.trace(ray, t_max, false);
-        (hit.object != u32::MAX).then_some(hit)
-    }
-
-    /// Whether anything lies on the ray in `(0, t_max)`.
-    #[inline(always)]
-    pub fn occluded(&mut self, ray: &Ray, t_max: f32) -> bool {
-        self.trace(ray, t_max, true).object != u32::MAX
-    }
-
-    /// Nearest hit in `(0, t_max)`, or with `any_hit` the first one found. Twin of WGSL
-    /// `trace_scene`.
-    #[inline(always)]
-    fn trace(&mut self, ray: &Ray, t_max: f32, any_hit: bool) -> Hit {
-        let mut hit = Hit::none(t_max);
-        if !self.scene.primitives.is_empty() {
-            let lanes = RayLanes::new(ray);
-            self.stack.clear();
-            let walk = Walk {
-                scene: self.scene,
-                ray,
-                sheared: ShearedRay::new(ray),
-                lanes: &lanes,
-                any_hit,
-            };
-            walk.tree(&mut self.stack, 0, &mut hit);
-        }
-        hit
-    }
+    hit
 }
 
 /// One ray query in progress.
@@ -302,9 +269,10 @@ pub(crate) mod tests {
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
 
-    use super::{Hit, Tracer};
+    use super::Hit;
     use crate::cpu_scene::CpuScene;
     use crate::intersect::{Ray, ShearedRay, intersect_triangle};
+    use crate::tracer::Tracer;
 
     /// The scene of `objects`, prepared.
     pub(crate) fn prepare(objects: Vec<Object>) -> PreparedScene {

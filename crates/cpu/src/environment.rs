@@ -1,15 +1,20 @@
-//! Light from infinitely far away: a constant radiance, or an equirectangular map evaluated
-//! bilinearly as Mitsuba 3's `envmap` and importance-sampled cell by cell
-//! (`pathlight_core::environment` describes the buffers). Twin of `environment.wgsl`.
+//! The environment light: light from infinitely far away, a constant radiance or an
+//! equirectangular map evaluated bilinearly as Mitsuba 3's `envmap` and importance-sampled
+//! cell by cell (`pathlight_core::environment` describes the buffers). [`crate::lights`]
+//! picks it with probability `env_pmf`; a constant environment samples directions
+//! cosine-weighted about the shading normal (the ideal density at a diffuse point). Twin of
+//! `environment.wgsl`.
 
-use std::f32::consts::{FRAC_1_PI, TAU};
+use std::f32::consts::{FRAC_1_PI, PI, TAU};
 
 use glam::{Vec2, Vec3A};
 use pathlight_core::environment::decode_rgb9e5;
 use pathlight_core::gpu_types::GpuRenderParams;
 
 use crate::cpu_scene::CpuScene;
+use crate::light_sample::LightSample;
 use crate::sampling::sin_cos_turns;
+use crate::sampling::{Frame, sample_cosine_hemisphere};
 
 /// Whether the environment is a map. Twin of WGSL `has_env_map`.
 #[inline(always)]
@@ -157,6 +162,50 @@ pub fn sample_env_map(scene: &CpuScene, params: &GpuRenderParams, u: Vec2) -> (V
         from_map(params, dir),
         p_row * p_column / cell_solid_angle(d, params, row),
     )
+}
+
+/// Density of choosing the environment and direction `wi` from a point with normal `n`
+/// (on the side light is gathered from). Twin of WGSL `env_pdf`.
+#[inline(always)]
+pub fn env_pdf(scene: &CpuScene, params: &GpuRenderParams, n: Vec3A, wi: Vec3A) -> f32 {
+    if has_env_map(params) {
+        return params.env_pmf * env_map_pdf(scene, params, wi);
+    }
+    params.env_pmf * n.dot(wi).max(0.0) / PI
+}
+
+/// A direction towards the environment from a point with normal `n`, its density including
+/// the choice of the environment (`env_pmf`). Twin of WGSL `sample_environment`.
+#[inline(always)]
+pub fn sample_environment(
+    scene: &CpuScene,
+    params: &GpuRenderParams,
+    n: Vec3A,
+    u: Vec2,
+) -> LightSample {
+    if has_env_map(params) {
+        let (wi, pdf) = sample_env_map(scene, params, u);
+        let pdf = params.env_pmf * pdf;
+        return LightSample {
+            wi,
+            point: Vec3A::ZERO,
+            finite: false,
+            radiance: env_radiance(scene, params, wi),
+            pdf,
+            valid: pdf > 0.0 && pdf.is_finite(),
+        };
+    }
+    let wi = Frame::around(n).to_world(sample_cosine_hemisphere(u));
+    let radiance = Vec3A::from(params.environment);
+    let pdf = env_pdf(scene, params, n, wi);
+    LightSample {
+        wi,
+        point: Vec3A::ZERO,
+        finite: false,
+        radiance,
+        pdf,
+        valid: pdf > 0.0,
+    }
 }
 
 #[cfg(test)]

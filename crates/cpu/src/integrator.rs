@@ -4,16 +4,18 @@
 use glam::Vec3A;
 use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams, NO_LIGHT};
 
-use crate::bvh::{Hit, Tracer};
+use crate::bvh::Hit;
 use crate::camera::camera_ray;
 use crate::cpu_scene::CpuScene;
-use crate::environment::env_radiance;
+use crate::environment::{env_pdf, env_radiance};
 use crate::intersect::Ray;
-use crate::lights::{LightSample, env_pdf, light_pdf, sample_light};
+use crate::light_sample::LightSample;
+use crate::lights::{light_pdf, sample_light};
 use crate::material::{eval_material, has_continuous_material_lobe, material_at, sample_material};
 use crate::sampler::{Draw, Sampler};
 use crate::sampling::power_heuristic;
 use crate::surface::surface_at;
+use crate::tracer::Tracer;
 
 /// Largest radiance one sample may add per channel (WGSL `SAMPLE_MAX`).
 pub const SAMPLE_MAX: f32 = 16_777_216.0;

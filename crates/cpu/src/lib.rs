@@ -5,6 +5,7 @@
 //! traced in packets ([`packet`]) through the 4-wide BVH both backends walk. The tests
 //! render scenes on both backends and compare.
 
+pub mod area_light;
 pub mod bvh;
 pub mod camera;
 pub mod cpu_scene;
@@ -12,6 +13,7 @@ pub mod display;
 pub mod environment;
 pub mod integrator;
 pub mod intersect;
+pub mod light_sample;
 pub mod lights;
 pub mod lobes;
 pub mod material;
@@ -23,19 +25,22 @@ pub mod sampler;
 pub mod sampling;
 pub mod surface;
 pub mod textures;
+pub mod tracer;
 
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
 use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams};
-use pathlight_core::{Accumulation, Film, PreparedScene, RenderError, Renderer, Shading};
+use pathlight_core::{
+    Accumulation, Film, PreparedScene, RenderError, Renderer, SampleCursor, Shading,
+};
 use pathlight_scene::{Camera, RenderSettings};
 use rayon::prelude::*;
 
-pub use crate::bvh::Tracer;
 pub use crate::cpu_scene::CpuScene;
 pub use crate::row::InstructionSet;
 use crate::row::{RowJob, Tally, render_row_with};
+pub use crate::tracer::Tracer;
 
 /// Aimed-for duration of one `advance` (for progress reports and interruption).
 const TARGET_BATCH: Duration = Duration::from_millis(250);
@@ -50,13 +55,10 @@ pub struct CpuRenderer {
     /// Per pixel, the sum of accumulated samples in the GPU's fixed point (exact, and the
     /// same whatever order they were added in).
     sums: Vec<GpuAccumPixel>,
-    samples_done: u32,
-    /// Index of every pixel's first sample.
-    first_sample: u32,
+    /// The samples the sums hold.
+    cursor: SampleCursor,
     /// Seconds one sample of one pixel took in the last render (`None` before the first).
     pixel_seconds: Option<f64>,
-    /// Rows of the pass in progress that already hold its sample.
-    rows_ahead: u32,
     /// Rays traced and samples dropped as not finite, since the last restart.
     tally: Tally,
     /// The compiled form of the path tracer that runs.
@@ -87,10 +89,8 @@ impl CpuRenderer {
             scene: scene.clone(),
             params,
             sums: vec![GpuAccumPixel::default(); pixels],
-            samples_done: 0,
-            first_sample: 0,
+            cursor: SampleCursor::default(),
             pixel_seconds: None,
-            rows_ahead: 0,
             tally: Tally::default(),
             isa: InstructionSet::best(),
         }
@@ -109,11 +109,11 @@ impl CpuRenderer {
         Ok(())
     }
 
-    /// Adds `samples` samples per pixel (from sample `first_sample + samples_done`) to the
-    /// pixels of `rows`.
+    /// Adds `samples` samples per pixel (from the cursor's next sample) to the pixels of
+    /// `rows`.
     fn render(&mut self, rows: Range<u32>, samples: u32) {
         let scene = CpuScene::new(&self.scene);
-        let offset = self.first_sample + self.samples_done;
+        let offset = self.cursor.next_sample();
         let (params, isa) = (&self.params, self.isa);
         let width = params.width as usize;
         let pixels = rows.start as usize * width..rows.end as usize * width;
@@ -143,15 +143,10 @@ impl CpuRenderer {
     /// whether they completed the pass.
     fn render_band(&mut self, rows: u32) -> bool {
         let height = self.params.height;
-        let end = (self.rows_ahead + rows.max(1)).min(height);
-        self.render(self.rows_ahead..end, 1);
-        self.rows_ahead = end;
-        if end < height {
-            return false;
-        }
-        self.rows_ahead = 0;
-        self.samples_done += 1;
-        true
+        let band = self.cursor.next_band(rows, height);
+        let end = band.end;
+        self.render(band, 1);
+        self.cursor.add_band(end, height)
     }
 
     /// Rows of one sample that take about `target` at the last render's speed (the whole
@@ -165,15 +160,14 @@ impl CpuRenderer {
     }
 
     /// The running sums, one per pixel, row by row, in the GPU's fixed point
-    /// (`AccumPixel`): rows `0 .. rows_ahead()` hold `samples_done() + 1` samples, the
-    /// others `samples_done()`.
+    /// (`AccumPixel`), holding the samples [`Self::cursor`] says.
     pub fn sums(&self) -> &[GpuAccumPixel] {
         &self.sums
     }
 
-    /// Rows of the pass in progress that already hold its sample.
-    pub fn rows_ahead(&self) -> u32 {
-        self.rows_ahead
+    /// The samples the sums hold.
+    pub fn cursor(&self) -> SampleCursor {
+        self.cursor
     }
 }
 
@@ -202,9 +196,7 @@ impl Renderer for CpuRenderer {
 
     fn restart(&mut self) {
         self.sums.fill(GpuAccumPixel::default());
-        self.samples_done = 0;
-        self.first_sample = 0;
-        self.rows_ahead = 0;
+        self.cursor = SampleCursor::default();
         self.tally = Tally::default();
     }
 
@@ -218,7 +210,7 @@ impl Renderer for CpuRenderer {
         let pixels = f64::from(self.params.width) * f64::from(self.params.height);
         let pass = self.pixel_seconds.map(|s| s * pixels);
         let target = TARGET_BATCH.as_secs_f64();
-        if self.rows_ahead > 0 || pass.is_some_and(|p| p > target) {
+        if self.cursor.in_pass() || pass.is_some_and(|p| p > target) {
             let rows = self.rows_for(TARGET_BATCH);
             return Ok(u32::from(self.render_band(rows)));
         }
@@ -228,7 +220,7 @@ impl Renderer for CpuRenderer {
             })
             .min(max_samples);
         self.render(0..self.params.height, samples);
-        self.samples_done += samples;
+        self.cursor.add_passes(samples);
         Ok(samples)
     }
 
@@ -249,14 +241,12 @@ impl Renderer for CpuRenderer {
     }
 
     fn samples_done(&self) -> u32 {
-        self.samples_done
+        self.cursor.samples
     }
 
     fn accumulation(&self) -> Result<Accumulation, RenderError> {
         Ok(Accumulation {
-            first_sample: self.first_sample,
-            samples: self.samples_done,
-            rows_ahead: self.rows_ahead,
+            cursor: self.cursor,
             sums: self.sums.clone(),
         })
     }
@@ -265,9 +255,7 @@ impl Renderer for CpuRenderer {
         let (width, height) = self.size();
         from.check_fits(width, height)?;
         self.sums.copy_from_slice(&from.sums);
-        self.first_sample = from.first_sample;
-        self.samples_done = from.samples;
-        self.rows_ahead = from.rows_ahead;
+        self.cursor = from.cursor;
         self.tally = Tally::default();
         Ok(())
     }
@@ -317,14 +305,14 @@ mod tests {
         banded.advance(1).unwrap();
         // Bands of 4, 4 and 2 rows complete the second pass.
         assert!(!banded.render_band(4));
-        assert_eq!(banded.rows_ahead, 4);
+        assert_eq!(banded.cursor.rows_ahead, 4);
         let mid = banded.film().unwrap();
         let split = 4 * 12;
         assert_eq!(mid.pixels[..split], two.pixels[..split], "rows ahead");
         assert_eq!(mid.pixels[split..], one.pixels[split..], "rows behind");
         assert!(!banded.render_band(4));
         assert!(banded.render_band(4));
-        assert_eq!(banded.rows_ahead, 0);
+        assert_eq!(banded.cursor.rows_ahead, 0);
         assert_eq!(banded.film().unwrap(), two);
     }
 }

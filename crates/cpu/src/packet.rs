@@ -18,7 +18,7 @@ use pathlight_core::gpu_types::{
     FLAG_ALPHA, FLAG_CAPS, GpuWideNode, KIND_QUAD, KIND_SPHERE, NO_TRIANGLE, SHAPE_LEAF,
 };
 
-use crate::bvh::{Entry, Hit, RayLanes, Tracer, Walk};
+use crate::bvh::{Entry, Hit, RayLanes, Walk};
 use crate::cpu_scene::CpuScene;
 use crate::intersect::{
     MISS, ROBUST_FAR, Ray, ShearedRay, intersect_cylinder, intersect_quad, intersect_sphere,
@@ -61,7 +61,7 @@ impl Default for RayPacket {
 }
 
 /// A packet's rays in structure-of-arrays form, per axis.
-struct PacketRays {
+pub(crate) struct PacketRays {
     origin: [[f32; PACKET]; 3],
     dir: [[f32; PACKET]; 3],
     inv_dir: [[f32; PACKET]; 3],
@@ -71,7 +71,7 @@ struct PacketRays {
 
 impl PacketRays {
     #[inline(always)]
-    fn new(packet: &RayPacket) -> Self {
+    pub(crate) fn new(packet: &RayPacket) -> Self {
         let mut rays = Self {
             origin: [[0.0; PACKET]; 3],
             dir: [[1.0; PACKET]; 3],
@@ -135,6 +135,19 @@ pub struct PacketHits {
 }
 
 impl PacketHits {
+    /// No hit yet for the rays of `packet`, the `active` ones searching.
+    #[inline(always)]
+    pub(crate) fn none(packet: &RayPacket, active: Lanes) -> Self {
+        Self {
+            t: packet.t_max,
+            object: [u32::MAX; PACKET],
+            primitive: [0; PACKET],
+            b1: [0.0; PACKET],
+            b2: [0.0; PACKET],
+            searching: active,
+        }
+    }
+
     /// The hit of ray `lane`, if it hit anything.
     #[inline(always)]
     pub fn hit(&self, lane: usize) -> Option<Hit> {
@@ -196,7 +209,7 @@ impl PacketHits {
 
     /// Lanes that have hit something.
     #[inline(always)]
-    fn found(&self) -> Lanes {
+    pub(crate) fn found(&self) -> Lanes {
         let mut found = 0;
         for l in 0..PACKET {
             found |= Lanes::from(self.object[l] != u32::MAX) << l;
@@ -290,62 +303,18 @@ fn max(a: f32, b: f32) -> f32 {
     if a > b { a } else { b }
 }
 
-impl Tracer<'_> {
-    /// Nearest hit in `(0, t_max)` of each active ray of `packet` (none for the others).
-    #[inline(always)]
-    pub fn intersect_packet(&mut self, packet: &RayPacket) -> PacketHits {
-        self.trace_packet(packet, false)
-    }
-
-    /// Bit `l` set: something lies on active ray `l` of `packet` in `(0, t_max)`.
-    #[inline(always)]
-    pub fn occluded_packet(&mut self, packet: &RayPacket) -> Lanes {
-        // Only traced lanes can have found something.
-        self.trace_packet(packet, true).found()
-    }
-
-    #[inline(always)]
-    fn trace_packet(&mut self, packet: &RayPacket, any_hit: bool) -> PacketHits {
-        let rays = PacketRays::new(packet);
-        let active = packet.active & (Lanes::MAX >> (Lanes::BITS as usize - PACKET));
-        let mut hits = PacketHits {
-            t: packet.t_max,
-            object: [u32::MAX; PACKET],
-            primitive: [0; PACKET],
-            b1: [0.0; PACKET],
-            b2: [0.0; PACKET],
-            searching: active,
-        };
-        if !self.scene.primitives.is_empty() && active != 0 {
-            let walk = PacketWalk {
-                scene: self.scene,
-                rays: &rays,
-                any_hit,
-            };
-            self.packet_stack.clear();
-            self.stack.clear();
-            let mut stacks = Stacks {
-                packet: &mut self.packet_stack,
-                single: &mut self.stack,
-            };
-            walk.tree(&mut stacks, 0, active, &mut hits);
-        }
-        hits
-    }
-}
-
 /// The two traversal stacks: nodes a packet still has to visit (with the lanes that
 /// entered them), and the single-ray walk's.
-struct Stacks<'a> {
-    packet: &'a mut Vec<(u32, Lanes)>,
-    single: &'a mut Vec<Entry>,
+pub(crate) struct Stacks<'a> {
+    pub packet: &'a mut Vec<(u32, Lanes)>,
+    pub single: &'a mut Vec<Entry>,
 }
 
 /// One packet query in progress.
-struct PacketWalk<'a> {
-    scene: &'a CpuScene<'a>,
-    rays: &'a PacketRays,
-    any_hit: bool,
+pub(crate) struct PacketWalk<'a> {
+    pub scene: &'a CpuScene<'a>,
+    pub rays: &'a PacketRays,
+    pub any_hit: bool,
 }
 
 impl PacketWalk<'_> {
@@ -353,7 +322,7 @@ impl PacketWalk<'_> {
     /// rays entering them). Leaves are tested as their node is visited; where fewer than
     /// [`MIN_SHARED_RAYS`] rays enter a node, each goes on alone from there.
     #[inline(always)]
-    fn tree(&self, stacks: &mut Stacks, root: u32, lanes: Lanes, hits: &mut PacketHits) {
+    pub(crate) fn tree(&self, stacks: &mut Stacks, root: u32, lanes: Lanes, hits: &mut PacketHits) {
         let base = stacks.packet.len();
         stacks.packet.push((root, lanes));
         while stacks.packet.len() > base {
@@ -528,10 +497,10 @@ mod tests {
     use rand::rngs::StdRng;
 
     use super::{Lanes, PACKET, RayPacket};
-    use crate::bvh::Tracer;
     use crate::bvh::tests::{assert_like_brute_force, prepare, random_ray, ray_into_scene};
     use crate::cpu_scene::CpuScene;
     use crate::intersect::Ray;
+    use crate::tracer::Tracer;
 
     /// Each ray traced in a packet with others of `rays`, at a lane that depends on the ray,
     /// gets brute force's answer. Every other packet holds the ray alone (it walks alone from

@@ -6,11 +6,11 @@ use std::ops::Range;
 use glam::Vec3A;
 use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams};
 
-use crate::bvh::Tracer;
 use crate::cpu_scene::CpuScene;
 use crate::integrator::{Path, T_MAX, accumulated_value, add_sample};
 use crate::packet::{PACKET, RayPacket};
 use crate::sampler::Sampler;
+use crate::tracer::Tracer;
 
 /// One row's share of an `advance`.
 pub(crate) struct RowJob<'a> {

@@ -237,9 +237,9 @@ fn densities_integrate_to_the_non_delta_probability() {
     }
 }
 
-/// The albedo two ways: the mean weight of `sample_bsdf`'s directions (an invalid sample
-/// weighs 0), and the integral of `eval_bsdf` over the sphere by uniform directions. They
-/// agree only if directions are drawn with the density `eval_bsdf` reports; a sample that
+/// The albedo two ways: the mean weight of `sample_material`'s directions (an invalid sample
+/// weighs 0), and the integral of `eval_material` over the sphere by uniform directions. They
+/// agree only if directions are drawn with the density `eval_material` reports; a sample that
 /// reaches a direction by a lobe whose density does not count it (a microfacet reflection
 /// that points into the surface) makes the first larger. Materials without delta lobes.
 #[test]

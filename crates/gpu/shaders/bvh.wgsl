@@ -156,7 +156,7 @@ fn order_pair(ka: ptr<function, f32>, ca: ptr<function, u32>, kb: ptr<function, 
 
 // Nearest hit in (0, t_max) over the whole scene, or with `any_hit` the first one found;
 // `object_count` 0 means an empty scene.
-// CPU twin: `Tracer::trace`.
+// CPU twin: `trace_scene`.
 fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
     var hit = Hit(t_max, NO_HIT, 0u, 0.0, 0.0);
     if object_count == 0u {

@@ -1,11 +1,15 @@
-// Light from infinitely far away: a constant radiance, or an equirectangular map evaluated
-// as Mitsuba 3's `envmap` (bilinear; column j centred at u = (j + 0.5) / width, row i at
-// v = i / (height - 1)) and importance-sampled by a piecewise-constant distribution over the
-// cells between texels (`crates/core/src/environment.rs` builds it and describes its layout).
+// The environment light: light from infinitely far away, a constant radiance or an
+// equirectangular map evaluated as Mitsuba 3's `envmap` (bilinear; column j centred at
+// u = (j + 0.5) / width, row i at v = i / (height - 1)) and importance-sampled by a
+// piecewise-constant distribution over the cells between texels
+// (`crates/core/src/environment.rs` builds it and describes its layout). `lights.wgsl` picks
+// it with probability env_pmf; a constant environment samples directions cosine-weighted
+// about the shading normal (for a diffuse point under constant light, the ideal density).
 // CPU twin: `crates/cpu/src/environment.rs`.
 
 #import params
 #import sampling
+#import light_sample
 
 // RGB9E5 texels of the map, row 0 on the +y pole (`EnvironmentData::texels`).
 @group(0) @binding(9) var<storage, read> env_texels: array<u32>;
@@ -160,4 +164,28 @@ fn sample_env_map(u: vec2f) -> EnvSample {
     let phi = TAU * turns;
     let d = vec3f(sin_theta * sin(phi), cos_theta, -sin_theta * cos(phi));
     return EnvSample(from_map(d), p_row * p_column / cell_solid_angle(row));
+}
+
+// Density of choosing the environment and direction `wi` from a point with normal `n` (on
+// the side light is gathered from).
+// CPU twin: `env_pdf`.
+fn env_pdf(n: vec3f, wi: vec3f) -> f32 {
+    if has_env_map() {
+        return params.env_pmf * env_map_pdf(wi);
+    }
+    return params.env_pmf * max(0.0, dot(n, wi)) / PI;
+}
+
+// A direction towards the environment from a point with normal `n`, its density including
+// the choice of the environment (env_pmf).
+// CPU twin: `sample_environment`.
+fn sample_environment(n: vec3f, u: vec2f) -> LightSample {
+    if has_env_map() {
+        let es = sample_env_map(u);
+        let pdf = params.env_pmf * es.pdf;
+        return LightSample(es.wi, vec3f(0.0), false, env_radiance(es.wi), pdf, pdf > 0.0 && pdf <= 3.0e38);
+    }
+    let wi = frame_around(n) * sample_cosine_hemisphere(u);
+    let pdf = env_pdf(n, wi);
+    return LightSample(wi, vec3f(0.0), false, params.environment, pdf, pdf > 0.0);
 }

@@ -1,82 +1,22 @@
-// Next-event estimation: choosing a light and a point on it, and the density of doing so.
-// CPU twin: `crates/cpu/src/lights.rs`. The environment is chosen with probability
-// env_pmf, directions from its map's distribution or, for a constant environment,
-// cosine-weighted about the shading normal; otherwise a shape light by power from `lights`.
-// Quads, cylinders and triangles are sampled by area, spheres by solid angle from outside.
+// Next-event estimation: choosing a light and a point on it, and the density of doing so,
+// with the one dispatch on the light type. The environment (`environment.wgsl`) is chosen
+// first, with probability env_pmf; otherwise an entry of the light table by power (a binary
+// search over its CDF), sampled by its type's file: LIGHT_AREA, `area_light.wgsl`. A new
+// light type adds a LIGHT_ constant and a case to each switch below (ARCHITECTURE.md, "How
+// to add a light type"). CPU twin: `crates/cpu/src/lights.rs`.
 
 #import scene
 #import params
-#import intersect
-#import sampling
+#import light_sample
 #import environment
-#import surface
-#import material
+#import area_light
 
-// CPU twin: `LightSample`.
-struct LightSample {
-    wi: vec3f,
-    // The point on the light (unused for the environment).
-    point: vec3f,
-    // False for the environment.
-    finite: bool,
-    radiance: vec3f,
-    // Solid-angle density including the choice of the light.
-    pdf: f32,
-    valid: bool,
-}
+// `Light.kind` (host: `pathlight_core::gpu_types`): an emissive shape or triangle.
+const LIGHT_AREA: u32 = 0u;
 
-fn invalid_light_sample() -> LightSample {
-    return LightSample(vec3f(0.0), vec3f(0.0), false, vec3f(0.0), 0.0, false);
-}
-
-// n: the normal on the side light is gathered from.
-// CPU twin: `env_pdf`.
-fn env_pdf(n: vec3f, wi: vec3f) -> f32 {
-    if has_env_map() {
-        return params.env_pmf * env_map_pdf(wi);
-    }
-    return params.env_pmf * max(0.0, dot(n, wi)) / PI;
-}
-
-// Surface area of light-table entry (o, primitive): the whole shape, or one triangle of a
-// mesh. The host computes the same areas to weigh the light table by power
-// (`crates/core/src/light_table.rs`).
-// CPU twin: `emitter_area`.
-fn emitter_area(o: Object, primitive: u32) -> f32 {
-    switch o.kind {
-        case KIND_QUAD: {
-            return length(cross(o.b.xyz, o.c.xyz));
-        }
-        case KIND_SPHERE: {
-            return 4.0 * PI * o.a.w * o.a.w;
-        }
-        case KIND_CYLINDER: {
-            let r = o.a.w;
-            let caps = select(0.0, 2.0 * PI * r * r, (o.flags & FLAG_CAPS) != 0u);
-            return TAU * r * length(o.b.xyz - o.a.xyz) + caps;
-        }
-        default: {
-            let i = 3u * primitive;
-            let v0 = vertices[i].position;
-            return 0.5 * length(cross(vertices[i + 1u].position - v0, vertices[i + 2u].position - v0));
-        }
-    }
-}
-
-// 1 - cos of the half-angle of the cone a sphere subtends from p; negative inside it.
-// CPU twin: `sphere_cone`.
-fn sphere_cone(center: vec3f, radius: f32, p: vec3f) -> f32 {
-    let d = center - p;
-    let d2 = dot(d, d);
-    let r2 = radius * radius;
-    if d2 <= r2 * 1.0001 {
-        return -1.0;
-    }
-    let sin2_max = r2 / d2;
-    let cos_max = sqrt(max(0.0, 1.0 - sin2_max));
-    return sin2_max / (1.0 + cos_max);
-}
-
+// Density (solid angle, including the choice of the light) with which `sample_light` from
+// `p` gives point `p_light` (normal `n_light`) of the emitter a ray hit: triangle
+// `primitive` of `object` (or the whole shape).
 // CPU twin: `light_pdf`.
 fn light_pdf(object: u32, primitive: u32, p: vec3f, p_light: vec3f, n_light: vec3f) -> f32 {
     let o = objects[object];
@@ -84,104 +24,21 @@ fn light_pdf(object: u32, primitive: u32, p: vec3f, p_light: vec3f, n_light: vec
     if o.kind == KIND_MESH {
         entry = o.light + primitive - o.first_triangle;
     }
-    let pmf = lights[entry].pmf * (1.0 - params.env_pmf);
-    let to_light = p_light - p;
-    let d2 = dot(to_light, to_light);
-    let cos_l = abs(dot(n_light, -to_light)) / sqrt(d2);
-    if o.kind == KIND_SPHERE {
-        let one_minus_cos = sphere_cone(o.a.xyz, o.a.w, p);
-        if one_minus_cos > 0.0 {
-            return pmf / (TAU * one_minus_cos);
-        }
-    }
-    let area = emitter_area(o, primitive);
-    if cos_l <= 0.0 || area <= 0.0 {
-        return 0.0;
-    }
-    return pmf * d2 / (cos_l * area);
-}
-
-// A point on a shape: point, normal, and its area density (a negative value: the
-// solid-angle density of a sphere's cone sample).
-struct ShapeSample {
-    point: vec3f,
-    normal: vec3f,
-    density: f32,
-    // Mesh triangle: its barycentrics (b1, b2) at the point.
-    barycentrics: vec2f,
-}
-
-// CPU twin: `sample_shape`.
-fn sample_shape(o: Object, primitive: u32, p: vec3f, u: vec2f, u_part: f32) -> ShapeSample {
-    let a = o.a.xyz;
-    let b = o.b.xyz;
-    let c = o.c.xyz;
-    switch o.kind {
-        case KIND_QUAD: {
-            let n = cross(b, c);
-            return ShapeSample(a + u.x * b + u.y * c, normalize(n), 1.0 / length(n), vec2f(0.0));
-        }
-        case KIND_SPHERE: {
-            let radius = o.a.w;
-            let one_minus_cos = sphere_cone(a, radius, p);
-            if one_minus_cos > 0.0 {
-                let cos_theta = 1.0 - u.x * one_minus_cos;
-                let sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
-                let phi = TAU * u.y;
-                let dir = frame_around(normalize(a - p)) * vec3f(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
-                var t = intersect_sphere(a, radius, Ray(p, dir), 1e30);
-                if t == MISS {
-                    t = dot(a - p, dir);
-                }
-                let q = p + t * dir;
-                return ShapeSample(q, normalize(q - a), -1.0 / (TAU * one_minus_cos), vec2f(0.0));
-            }
-            let n = sample_uniform_sphere(u);
-            return ShapeSample(a + radius * n, n, 1.0 / (4.0 * PI * radius * radius), vec2f(0.0));
-        }
-        case KIND_CYLINDER: {
-            let radius = o.a.w;
-            let axis_full = b - a;
-            let height = length(axis_full);
-            let axis = axis_full / height;
-            let frame = frame_around(axis);
-            let area = emitter_area(o, primitive);
-            let side = TAU * radius * height;
-            if u_part * area < side || (o.flags & FLAG_CAPS) == 0u {
-                let phi = TAU * u.x;
-                let radial = frame[0] * cos(phi) + frame[1] * sin(phi);
-                return ShapeSample(a + axis * (u.y * height) + radial * radius, radial, 1.0 / area, vec2f(0.0));
-            }
-            let top = u_part * area >= side + 0.5 * (area - side);
-            let d = sample_disk(u) * radius;
-            let center = select(a, b, top);
-            return ShapeSample(center + frame[0] * d.x + frame[1] * d.y, select(-axis, axis, top), 1.0 / area, vec2f(0.0));
-        }
-        default: {
-            let i = 3u * primitive;
-            let v0 = vertices[i].position;
-            let v1 = vertices[i + 1u].position;
-            let v2 = vertices[i + 2u].position;
-            let su = sqrt(u.x);
-            let b1 = 1.0 - su;
-            let b2 = u.y * su;
-            let n = cross(v1 - v0, v2 - v0);
-            return ShapeSample(v0 + b1 * (v1 - v0) + b2 * (v2 - v0), normalize(n), 2.0 / length(n), vec2f(b1, b2));
+    let light = lights[entry];
+    let pmf = light.pmf * (1.0 - params.env_pmf);
+    switch light.kind {
+        case LIGHT_AREA, default: {
+            return area_light_pdf(object, primitive, pmf, p, p_light, n_light);
         }
     }
 }
 
+// A light and a point on it as seen from `p` with normal `n` (on the side light is gathered
+// from): `u_select` chooses the light, `u` the point.
 // CPU twin: `sample_light`.
 fn sample_light(p: vec3f, n: vec3f, u_select: f32, u: vec2f) -> LightSample {
     if u_select < params.env_pmf {
-        if has_env_map() {
-            let es = sample_env_map(u);
-            let pdf = params.env_pmf * es.pdf;
-            return LightSample(es.wi, vec3f(0.0), false, env_radiance(es.wi), pdf, pdf > 0.0 && pdf <= 3.0e38);
-        }
-        let wi = frame_around(n) * sample_cosine_hemisphere(u);
-        let pdf = env_pdf(n, wi);
-        return LightSample(wi, vec3f(0.0), false, params.environment, pdf, pdf > 0.0);
+        return sample_environment(n, u);
     }
     if params.light_count == 0u {
         return invalid_light_sample();
@@ -198,30 +55,13 @@ fn sample_light(p: vec3f, n: vec3f, u_select: f32, u: vec2f) -> LightSample {
         }
     }
     let light = lights[lo];
+    // The part of u_light inside the chosen entry, for the light's own choices.
     let below = light.cdf - light.pmf;
     let u_part = clamp((u_light - below) / max(light.pmf, 1e-30), 0.0, 1.0);
-    let o = objects[light.object];
-    let ss = sample_shape(o, light.primitive, p, u, u_part);
-    let to_light = ss.point - p;
-    let distance = length(to_light);
-    if distance <= 0.0 {
-        return invalid_light_sample();
-    }
-    let wi = to_light / distance;
-    let cos_l = dot(ss.normal, -wi);
-    if cos_l <= 0.0 {
-        return invalid_light_sample();
-    }
     let pmf = light.pmf * (1.0 - params.env_pmf);
-    var pdf: f32;
-    if ss.density < 0.0 {
-        pdf = pmf * -ss.density;
-    } else {
-        pdf = pmf * ss.density * distance * distance / cos_l;
+    switch light.kind {
+        case LIGHT_AREA, default: {
+            return sample_area_light(light.index, light.primitive, pmf, p, u, u_part);
+        }
     }
-    var radiance = materials[o.material].emission;
-    if o.kind == KIND_MESH {
-        radiance = emission_at(o.material, triangle_uv(light.primitive, ss.barycentrics.x, ss.barycentrics.y));
-    }
-    return LightSample(wi, ss.point, true, radiance, pdf, pdf > 0.0 && pdf <= 3.0e38);
 }

@@ -32,9 +32,12 @@ struct Object {
 
 const NO_LIGHT: u32 = 0xffffffffu;
 
-// One emitter chosen with probability pmf (cdf: cumulative). Host: `GpuLight`.
+// A light-table entry: a light of type `kind` (LIGHT_ of lights.wgsl; LIGHT_AREA: object
+// `index`, its triangle `primitive`), chosen with probability pmf (cdf: cumulative). Host:
+// `GpuLight`.
 struct Light {
-    object: u32,
+    kind: u32,
+    index: u32,
     primitive: u32,
     cdf: f32,
     pmf: f32,

@@ -56,7 +56,7 @@ impl<'a> DisplaySource<'a> {
             width,
             height,
             samples: renderer.samples_done(),
-            rows_ahead: renderer.rows_ahead(),
+            rows_ahead: renderer.cursor().rows_ahead,
         }
     }
 }

@@ -7,7 +7,9 @@
 use std::time::{Duration, Instant};
 
 use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams};
-use pathlight_core::{Accumulation, Film, PreparedScene, RenderError, Renderer, Shading};
+use pathlight_core::{
+    Accumulation, Film, PreparedScene, RenderError, Renderer, SampleCursor, Shading,
+};
 use pathlight_scene::{Camera, RenderSettings};
 
 use crate::context::{GpuContext, describe};
@@ -79,14 +81,10 @@ pub struct GpuRenderer {
     frame_layout: wgpu::BindGroupLayout,
     frame_bind_group: wgpu::BindGroup,
     params: GpuRenderParams,
-    /// Rows of the frame in progress ([`Self::step_frame`]) that already hold its sample.
-    rows_ahead: u32,
     /// Entries of the pipeline's traversal stack.
     stack_size: u32,
-    /// Samples per pixel accumulated so far.
-    samples_done: u32,
-    /// Index of every pixel's first sample.
-    first_sample: u32,
+    /// The samples the accumulation buffer holds.
+    cursor: SampleCursor,
     /// Current piece size: rows per dispatch and samples per pixel per dispatch.
     rows_per_dispatch: u32,
     batch_samples: u32,
@@ -159,14 +157,12 @@ impl GpuRenderer {
             counters,
             frame_layout,
             frame_bind_group,
-            rows_ahead: 0,
             stack_size,
             rows_per_dispatch: params.height.min(WORKGROUP * 4),
             batch_samples: 1,
             adaptive: true,
             params,
-            samples_done: 0,
-            first_sample: 0,
+            cursor: SampleCursor::default(),
         })
     }
 
@@ -179,10 +175,9 @@ impl GpuRenderer {
         self.adaptive = false;
     }
 
-    /// Rows of the frame in progress that already hold its sample (see
-    /// [`Renderer::step_frame`]).
-    pub fn rows_ahead(&self) -> u32 {
-        self.rows_ahead
+    /// The samples the accumulation buffer holds (see [`Renderer::step_frame`]).
+    pub fn cursor(&self) -> SampleCursor {
+        self.cursor
     }
 
     /// The accumulation buffer (per pixel [`GpuAccumPixel`]: a fixed-point sum of samples),
@@ -207,7 +202,7 @@ impl GpuRenderer {
     /// Queues `samples` samples per pixel for rows `row .. row + rows`.
     fn submit(&self, row: u32, rows: u32, samples: u32) {
         let params = GpuRenderParams {
-            sample_offset: self.first_sample + self.samples_done,
+            sample_offset: self.cursor.next_sample(),
             batch_samples: samples,
             row_offset: row,
             row_end: row + rows,
@@ -329,9 +324,7 @@ impl Renderer for GpuRenderer {
         encoder.clear_buffer(&self.accum_buffer, 0, None);
         encoder.clear_buffer(&self.counters, 0, None);
         self.ctx.queue.submit([encoder.finish()]);
-        self.samples_done = 0;
-        self.first_sample = 0;
-        self.rows_ahead = 0;
+        self.cursor = SampleCursor::default();
     }
 
     /// One submission of about [`TARGET_SUBMISSION`]: samples over the whole image, or, when
@@ -341,14 +334,14 @@ impl Renderer for GpuRenderer {
         if samples == 0 {
             return Ok(0);
         }
-        if self.rows_ahead > 0 || self.rows_per_dispatch < self.params.height {
+        if self.cursor.in_pass() || self.rows_per_dispatch < self.params.height {
             let done = self.step_frame(TARGET_SUBMISSION)?;
             return Ok(u32::from(done));
         }
         let started = Instant::now();
         self.submit(0, self.params.height, samples);
         self.wait()?;
-        self.samples_done += samples;
+        self.cursor.add_passes(samples);
         if self.adaptive {
             self.reschedule(started.elapsed(), samples);
         }
@@ -356,15 +349,16 @@ impl Renderer for GpuRenderer {
     }
 
     /// Renders the next band of rows, sized so that a submission takes about `target`.
-    /// Rows `0 .. rows_ahead()` of an incomplete frame hold one sample more than the others.
+    /// Rows `0 .. cursor().rows_ahead` of an incomplete frame hold one sample more than the
+    /// others.
     fn step_frame(&mut self, target: Duration) -> Result<bool, RenderError> {
         let height = self.params.height;
-        let rows = self.rows_per_dispatch.min(height - self.rows_ahead);
+        let band = self.cursor.next_band(self.rows_per_dispatch, height);
+        let rows = band.len() as u32;
         let started = Instant::now();
-        self.submit(self.rows_ahead, rows, 1);
+        self.submit(band.start, rows, 1);
         self.wait()?;
         let elapsed = started.elapsed();
-        self.rows_ahead += rows;
         if self.adaptive {
             // Next band: scale by the measured time, in whole workgroups of rows.
             let scale = target.as_secs_f64() / elapsed.as_secs_f64().max(1e-6);
@@ -373,18 +367,15 @@ impl Renderer for GpuRenderer {
             self.rows_per_dispatch =
                 (workgroups as u32 * WORKGROUP).clamp(WORKGROUP.min(height), height);
         }
-        if self.rows_ahead < height {
-            return Ok(false);
-        }
-        self.rows_ahead = 0;
-        self.samples_done += 1;
-        Ok(true)
+        Ok(self.cursor.add_band(band.end, height))
     }
 
-    /// One dispatch over the whole image, not waited for.
+    /// The rest of the pass in progress, or a whole one, as one dispatch not waited for.
     fn queue_frame(&mut self) -> Result<(), RenderError> {
-        self.submit(0, self.params.height, 1);
-        self.samples_done += 1;
+        let height = self.params.height;
+        let band = self.cursor.next_band(height, height);
+        self.submit(band.start, band.len() as u32, 1);
+        self.cursor.add_band(band.end, height);
         Ok(())
     }
 
@@ -393,14 +384,12 @@ impl Renderer for GpuRenderer {
     }
 
     fn samples_done(&self) -> u32 {
-        self.samples_done
+        self.cursor.samples
     }
 
     fn accumulation(&self) -> Result<Accumulation, RenderError> {
         Ok(Accumulation {
-            first_sample: self.first_sample,
-            samples: self.samples_done,
-            rows_ahead: self.rows_ahead,
+            cursor: self.cursor,
             sums: self.read_buffer(&self.accum_buffer)?,
         })
     }
@@ -411,9 +400,7 @@ impl Renderer for GpuRenderer {
         self.ctx
             .queue
             .write_buffer(&self.accum_buffer, 0, bytemuck::cast_slice(&from.sums));
-        self.first_sample = from.first_sample;
-        self.samples_done = from.samples;
-        self.rows_ahead = from.rows_ahead;
+        self.cursor = from.cursor;
         Ok(())
     }
 

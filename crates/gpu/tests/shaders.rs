@@ -120,7 +120,7 @@ fn host_structs_match_their_wgsl_declarations() {
             triangle_count
         ]
     );
-    assert_layout!(m, "Light", GpuLight, [object, primitive, cdf, pmf]);
+    assert_layout!(m, "Light", GpuLight, [kind, index, primitive, cdf, pmf]);
     assert_layout!(
         m,
         "WideNode",
@@ -255,6 +255,7 @@ fn host_constants_match_their_wgsl_declarations() {
         ("FLAG_CAPS", t::FLAG_CAPS),
         ("FLAG_ALPHA", t::FLAG_ALPHA),
         ("NO_LIGHT", t::NO_LIGHT),
+        ("LIGHT_AREA", t::LIGHT_AREA),
         ("NO_TRIANGLE", t::NO_TRIANGLE),
         ("SHAPE_LEAF", t::SHAPE_LEAF),
         ("MATERIAL_MASK", t::MATERIAL_MASK),

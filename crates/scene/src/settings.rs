@@ -1,4 +1,5 @@
-//! Sampling settings of a render and the limits every input is checked against.
+//! Sampling settings of a render and the limits every input is checked against, by the
+//! scene loader and the command line alike (each names the key or option it checked).
 
 use crate::error::RangeError;
 
@@ -67,5 +68,51 @@ pub fn check_max_depth(max_depth: u32) -> Result<(), RangeError> {
         Err(RangeError(format!(
             "max_depth = {max_depth} is out of range 1..={MAX_DEPTH}"
         )))
+    }
+}
+
+/// Checks a thin lens's radius (`name` is the key or option that gave it): 0 (a pinhole) up
+/// to [`MAX_COORDINATE`].
+pub fn check_aperture(name: &str, radius: f32) -> Result<f32, RangeError> {
+    if (0.0..=MAX_COORDINATE).contains(&radius) {
+        Ok(radius)
+    } else {
+        Err(RangeError(format!(
+            "{name} = {radius} must be >= 0 and at most {MAX_COORDINATE:e}"
+        )))
+    }
+}
+
+/// Checks a length that must be positive, such as a focus distance (`name` is the key or
+/// option that gave it): above 0, up to [`MAX_COORDINATE`].
+pub fn check_length(name: &str, length: f32) -> Result<f32, RangeError> {
+    if length > 0.0 && length <= MAX_COORDINATE {
+        Ok(length)
+    } else {
+        Err(RangeError(format!(
+            "{name} = {length} must be > 0 and at most {MAX_COORDINATE:e}"
+        )))
+    }
+}
+
+/// Checks an environment map's strength (`name` is the key or option that gave it): finite
+/// and >= 0.
+pub fn check_env_strength(name: &str, strength: f32) -> Result<f32, RangeError> {
+    if strength.is_finite() && strength >= 0.0 {
+        Ok(strength)
+    } else {
+        Err(RangeError(format!(
+            "{name} = {strength} must be finite and >= 0"
+        )))
+    }
+}
+
+/// Checks an environment map's rotation in degrees (`name` is the key or option that gave
+/// it): finite.
+pub fn check_env_rotation(name: &str, degrees: f32) -> Result<f32, RangeError> {
+    if degrees.is_finite() {
+        Ok(degrees)
+    } else {
+        Err(RangeError(format!("{name} = {degrees} must be finite")))
     }
 }

@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::anyhow;
 use pathlight_core::gpu_types::GpuAccumPixel;
-use pathlight_core::{Film, RenderError, Renderer, Shading};
+use pathlight_core::{Film, RenderError, Renderer, SampleCursor, Shading};
 use pathlight_cpu::CpuRenderer;
 use pathlight_cpu::display::{CpuDisplay, DisplayImage};
 use pathlight_gpu::display::DisplaySource;
@@ -31,8 +31,8 @@ struct Image {
     epoch: u64,
     width: u32,
     height: u32,
-    samples: u32,
-    rows_ahead: u32,
+    /// The samples the pixels hold.
+    cursor: SampleCursor,
     rays: u64,
     /// Fixed-point sums, row by row.
     pixels: Vec<GpuAccumPixel>,
@@ -44,8 +44,8 @@ impl Image {
             pixels: &self.pixels,
             width: self.width,
             height: self.height,
-            samples: self.samples,
-            rows_ahead: self.rows_ahead,
+            samples: self.cursor.samples,
+            rows_ahead: self.cursor.rows_ahead,
         }
     }
 }
@@ -172,8 +172,8 @@ impl CpuFrames {
             pixels: buffer,
             width: image.width.max(1),
             height: image.height.max(1),
-            samples: image.samples,
-            rows_ahead: image.rows_ahead,
+            samples: image.cursor.samples,
+            rows_ahead: image.cursor.rows_ahead,
         }
     }
 }
@@ -271,14 +271,13 @@ impl Frames for CpuFrames {
         Ok(Film::from_fixed_point(
             image.width,
             image.height,
-            image.samples,
-            image.rows_ahead,
+            &image.cursor,
             &image.pixels,
         ))
     }
 
     fn samples_done(&self) -> u32 {
-        self.shared.lock().image.samples
+        self.shared.lock().image.cursor.samples
     }
 
     fn rays_traced(&self) -> anyhow::Result<u64> {
@@ -334,7 +333,7 @@ fn render_loop(mut renderer: CpuRenderer, shared: &Shared, notify: impl Fn()) {
             (change, band)
         };
         let started = Instant::now();
-        let first_row = renderer.rows_ahead();
+        let first_row = renderer.cursor().rows_ahead;
         let result = match change {
             // Back to the orders: frames are rendered once wanted.
             Some((camera, shading)) => apply(&mut renderer, camera, shading).map(|()| None),
@@ -355,7 +354,7 @@ fn render_loop(mut renderer: CpuRenderer, shared: &Shared, notify: impl Fn()) {
         let end_row = if frame_done {
             height
         } else {
-            renderer.rows_ahead()
+            renderer.cursor().rows_ahead
         };
         let mut state = shared.lock();
         if state.generation == generation {
@@ -384,8 +383,7 @@ fn publish(renderer: &CpuRenderer, epoch: u64, rows: Range<u32>, image: &mut Ima
     }
     image.epoch = epoch;
     (image.width, image.height) = (width, height);
-    image.samples = renderer.samples_done();
-    image.rows_ahead = renderer.rows_ahead();
+    image.cursor = renderer.cursor();
     image.rays = renderer.rays_traced().unwrap_or(0);
 }
 

@@ -291,10 +291,10 @@ fn frames_in_bands_and_scene_changes_keep_the_image_exact() {
     let (mut frames, mut partials) = (0, 0);
     while frames < 3 {
         frames += u32::from(r.step_frame(std::time::Duration::ZERO).unwrap());
-        if frames == 2 && r.rows_ahead() > 0 {
+        if frames == 2 && r.cursor().rows_ahead > 0 {
             // Mid-frame: the sampled rows equal a 3-sample image, the rest a 2-sample one.
             let partial = r.film().unwrap();
-            let ahead = (r.rows_ahead() * 24) as usize;
+            let ahead = (r.cursor().rows_ahead * 24) as usize;
             assert_eq!(partial.pixels[..ahead], reference.pixels[..ahead]);
             assert_ne!(partial.pixels[ahead..], reference.pixels[ahead..]);
             partials += 1;

@@ -19,7 +19,7 @@ fn resumed_and_split_renders_equal_the_whole_one() {
     render_to(&mut first, 3);
     assert!(!first.step_frame(std::time::Duration::ZERO).unwrap());
     let saved = first.accumulation().unwrap();
-    assert_eq!((saved.samples, saved.rows_ahead), (3, 8));
+    assert_eq!((saved.cursor.samples, saved.cursor.rows_ahead), (3, 8));
     let mut resumed = gpu_renderer(&scene);
     resumed.resume(&saved).unwrap();
     assert!(render_to(&mut resumed, 7) == whole, "resumed mid-pass");

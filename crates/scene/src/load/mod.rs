@@ -14,8 +14,12 @@ use glam::Vec3;
 use toml::Spanned;
 
 use crate::desc::{EnvironmentDesc, RenderDesc, SamplerDesc, SceneDesc};
+use crate::error::RangeError;
 use crate::error::SceneError;
-use crate::settings::{MAX_COORDINATE, check_max_depth, check_resolution, check_spp};
+use crate::settings::{
+    MAX_COORDINATE, check_aperture, check_env_rotation, check_env_strength, check_length,
+    check_max_depth, check_resolution, check_spp,
+};
 use crate::{Camera, Environment, HdrImage, RenderSettings, Sampler, Scene, Texture};
 
 /// Where a scene's text and assets come from.
@@ -140,15 +144,10 @@ impl Builder<'_, '_> {
         }
         let [width, height] = c.resolution;
         check_resolution(width, height).map_err(|e| self.invalid(span.clone(), e.to_string()))?;
-        if !(c.aperture_radius >= 0.0 && c.aperture_radius <= MAX_COORDINATE) {
-            return Err(self.invalid(
-                span,
-                format!(
-                    "camera.aperture_radius = {} must be >= 0 and at most {MAX_COORDINATE:e}",
-                    c.aperture_radius
-                ),
-            ));
-        }
+        let range = |result: Result<f32, RangeError>| {
+            result.map_err(|e| self.invalid(span.clone(), e.to_string()))
+        };
+        let aperture_radius = range(check_aperture("camera.aperture_radius", c.aperture_radius))?;
         let focus_distance = match c.focus_distance {
             Some(d) => self.length(span, "camera.focus_distance", d)?,
             None => position.distance(look_at),
@@ -160,7 +159,7 @@ impl Builder<'_, '_> {
             fov_y_deg: c.fov_y,
             width,
             height,
-            aperture_radius: c.aperture_radius,
+            aperture_radius,
             focus_distance,
         })
     }
@@ -184,20 +183,17 @@ impl Builder<'_, '_> {
                 )?))
             }
             (None, Some(path)) => {
-                let strength = e.strength.unwrap_or(1.0);
-                if !(strength.is_finite() && strength >= 0.0) {
-                    return Err(self.invalid(
-                        span,
-                        format!("{} = {strength} must be finite and >= 0", key("strength")),
-                    ));
-                }
-                let rotation = e.rotation.unwrap_or(0.0);
-                if !rotation.is_finite() {
-                    return Err(self.invalid(
-                        span,
-                        format!("{} = {rotation} must be finite", key("rotation")),
-                    ));
-                }
+                let range = |result: Result<f32, RangeError>| {
+                    result.map_err(|e| self.invalid(span.clone(), e.to_string()))
+                };
+                let strength = range(check_env_strength(
+                    &key("strength"),
+                    e.strength.unwrap_or(1.0),
+                ))?;
+                let rotation = range(check_env_rotation(
+                    &key("rotation"),
+                    e.rotation.unwrap_or(0.0),
+                ))?;
                 let (full, bytes) = self.asset_bytes(path).map_err(|err| match err {
                     SceneError::Io { path, source } => self.invalid(
                         span.clone(),
@@ -242,14 +238,7 @@ impl Builder<'_, '_> {
 
     /// A length (a radius): finite, above zero and within the coordinate limit.
     fn length(&self, span: Range<usize>, key: &str, value: f32) -> Result<f32, SceneError> {
-        if value > 0.0 && value <= MAX_COORDINATE {
-            Ok(value)
-        } else {
-            Err(self.invalid(
-                span,
-                format!("{key} = {value} must be > 0 and at most {MAX_COORDINATE:e}"),
-            ))
-        }
+        check_length(key, value).map_err(|e| self.invalid(span, e.to_string()))
     }
 
     fn radiance(&self, span: Range<usize>, key: &str, v: [f32; 3]) -> Result<Vec3, SceneError> {

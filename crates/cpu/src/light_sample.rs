@@ -1,0 +1,32 @@
+//! What every light type's sampling returns: a direction towards the light, the point it
+//! reaches (for a finite light), the radiance arriving and the density of having sampled
+//! it. Twin of `light_sample.wgsl`.
+
+use glam::Vec3A;
+
+/// A sampled light direction. Twin of WGSL `LightSample`.
+#[derive(Debug, Clone, Copy)]
+pub struct LightSample {
+    /// Unit direction from the shading point to the light.
+    pub wi: Vec3A,
+    /// The sampled point on the light (unused for the environment).
+    pub point: Vec3A,
+    /// False for the environment (infinitely far).
+    pub finite: bool,
+    /// Emitted radiance towards the shading point.
+    pub radiance: Vec3A,
+    /// Solid-angle density, including the choice of the light.
+    pub pdf: f32,
+    /// False when the sample cannot contribute (back side, zero density).
+    pub valid: bool,
+}
+
+/// No sample. Twin of WGSL `invalid_light_sample`.
+pub const INVALID: LightSample = LightSample {
+    wi: Vec3A::ZERO,
+    point: Vec3A::ZERO,
+    finite: false,
+    radiance: Vec3A::ZERO,
+    pdf: 0.0,
+    valid: false,
+};
