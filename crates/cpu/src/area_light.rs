@@ -44,11 +44,16 @@ fn sphere_cone(center: Vec3A, radius: f32, p: Vec3A) -> f32 {
 }
 
 /// Density (solid angle) of sampling point `p_light` with normal `n_light` on entry
-/// `(object, primitive)` from `p`, which was chosen with probability `pmf`. Twin of WGSL
-/// `area_light_pdf`.
+/// `(object, primitive)` (`o` is the object) from `p`, which was chosen with probability
+/// `pmf`. Twin of WGSL `area_light_pdf`.
 #[inline(always)]
+#[expect(
+    clippy::too_many_arguments,
+    reason = "the object both by index and looked up"
+)]
 pub fn area_light_pdf(
     scene: &CpuScene,
+    o: &GpuObject,
     object: u32,
     primitive: u32,
     pmf: f32,
@@ -56,7 +61,6 @@ pub fn area_light_pdf(
     p_light: Vec3A,
     n_light: Vec3A,
 ) -> f32 {
-    let o = &scene.objects[object as usize];
     let to_light = p_light - p;
     let d2 = to_light.length_squared();
     let cos_l = n_light.dot(-to_light).abs() / d2.sqrt();

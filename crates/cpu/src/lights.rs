@@ -35,7 +35,7 @@ pub fn light_pdf(
     let light = &scene.lights[entry as usize];
     let pmf = light.pmf * (1.0 - params.env_pmf);
     match light.kind {
-        _ => area_light_pdf(scene, object, primitive, pmf, p, p_light, n_light),
+        _ => area_light_pdf(scene, o, object, primitive, pmf, p, p_light, n_light),
     }
 }
 

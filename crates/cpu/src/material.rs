@@ -4,7 +4,7 @@
 //! `material.wgsl`.
 
 use glam::{Vec2, Vec3A, Vec4};
-use pathlight_core::gpu_types::{TEXTURE_BASE, TEXTURE_EMISSION};
+use pathlight_core::gpu_types::{GpuMaterial, TEXTURE_BASE, TEXTURE_EMISSION};
 use pathlight_core::materials::MODEL_METAL_ROUGH;
 
 use crate::cpu_scene::CpuScene;
@@ -16,8 +16,10 @@ use crate::microfacet::{BsdfEval, BsdfSample};
 use crate::surface::Surface;
 use crate::textures::{has_texture, material_texture, srgb_to_linear};
 
-/// Vectors of a model's parameter block the kernels load (WGSL `MODEL_PARAMS`).
+/// Vectors of a model's parameter block the kernels load (WGSL `MODEL_PARAMS`; `material_at`
+/// loads them one by one).
 pub const MODEL_PARAMS: usize = pathlight_core::materials::MODEL_PARAMS;
+const _: () = assert!(MODEL_PARAMS == 4);
 
 /// A material with its textures applied at a point: what its model's BSDF reads. Twin of
 /// WGSL `MaterialPoint`.
@@ -38,8 +40,13 @@ pub struct MaterialPoint {
 pub fn material_at(scene: &CpuScene, index: u32, uv: Vec2) -> MaterialPoint {
     let m = &scene.materials[index as usize];
     let first = m.params as usize;
-    let mut params: [Vec4; MODEL_PARAMS] =
-        std::array::from_fn(|i| Vec4::from_array(scene.material_params[first + i]));
+    let block = &scene.material_params[first..first + MODEL_PARAMS];
+    let mut params = [
+        Vec4::from_array(block[0]),
+        Vec4::from_array(block[1]),
+        Vec4::from_array(block[2]),
+        Vec4::from_array(block[3]),
+    ];
     let mut base_color = Vec3A::from(m.base_color);
     if has_texture(m, TEXTURE_BASE) {
         let texel = material_texture(scene, m, TEXTURE_BASE, uv)
@@ -53,7 +60,7 @@ pub fn material_at(scene: &CpuScene, index: u32, uv: Vec2) -> MaterialPoint {
     MaterialPoint {
         model: m.model,
         base_color,
-        emission: emission_at(scene, index, uv),
+        emission: emission(scene, m, uv),
         params,
     }
 }
@@ -62,7 +69,12 @@ pub fn material_at(scene: &CpuScene, index: u32, uv: Vec2) -> MaterialPoint {
 /// `emission_at`.
 #[inline(always)]
 pub fn emission_at(scene: &CpuScene, index: u32, uv: Vec2) -> Vec3A {
-    let m = &scene.materials[index as usize];
+    emission(scene, &scene.materials[index as usize], uv)
+}
+
+/// The radiance material `m` emits at `uv`.
+#[inline(always)]
+fn emission(scene: &CpuScene, m: &GpuMaterial, uv: Vec2) -> Vec3A {
     let emission = Vec3A::from(m.emission);
     if has_texture(m, TEXTURE_EMISSION) {
         let texel = material_texture(scene, m, TEXTURE_EMISSION, uv)

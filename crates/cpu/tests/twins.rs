@@ -73,6 +73,7 @@ fn rust_claims() -> BTreeSet<Pair> {
         let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
         let text = std::fs::read_to_string(&path).unwrap();
         let (mut implementing, mut doc) = (None, String::new());
+        let mut in_attribute = false;
         for line in text.lines() {
             if line.starts_with("impl") {
                 implementing = impl_type(line);
@@ -85,7 +86,9 @@ fn rust_claims() -> BTreeSet<Pair> {
                 doc.push_str(comment.trim());
                 continue;
             }
-            if trimmed.starts_with("#[") {
+            // Attributes, also those rustfmt spreads over several lines.
+            if in_attribute || trimmed.starts_with("#[") {
+                in_attribute = !trimmed.ends_with(']');
                 continue;
             }
             let names = quoted_after(&doc, "Twin of WGSL");
