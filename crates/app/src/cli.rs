@@ -29,6 +29,41 @@ pub enum Command {
     Bench(BenchArgs),
     /// Sum render states (shards, checkpoints) exactly into one image or state.
     Merge(MergeArgs),
+    /// Denoise an image (an EXR that `render` wrote) or a render's state with Open Image
+    /// Denoise, guided by its albedo and normal images when it has them.
+    Denoise(DenoiseArgs),
+}
+
+/// The auxiliary images (AOVs) a render can write beside its image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Aov {
+    /// The albedo of the first surface that is not a perfect mirror or glass (what a
+    /// denoiser reads), in [0, 1].
+    Albedo,
+    /// That surface's shading normal in world space, in [-1, 1].
+    Normal,
+}
+
+impl Aov {
+    /// Its layer name in an EXR (`albedo.R`, `normal.X`) and the suffix of its PNG
+    /// (`out.albedo.png`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Albedo => "albedo",
+            Self::Normal => "normal",
+        }
+    }
+}
+
+/// How hard the denoiser works.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DenoiseMode {
+    /// Final images: the albedo and normal denoised first (Open Image Denoise's
+    /// prefiltering), then the image with them as clean guides, at high quality.
+    Final,
+    /// Previews: the image with the albedo and normal as they are, at balanced quality
+    /// (about a third of `final`'s time; what the viewer uses).
+    Fast,
 }
 
 /// Where the light transport runs.
@@ -157,6 +192,35 @@ pub struct RenderArgs {
     /// (Kubernetes, AWS Batch).
     #[arg(long, value_name = "N", requires = "shard", value_parser = clap::value_parser!(u32).range(1..))]
     pub shard_count: Option<u32>,
+    /// Also render these auxiliary images (comma-separated) from the same samples, and
+    /// write them: as layers of an EXR (`albedo.R`, `normal.X`, ...), beside a PNG
+    /// (`out.albedo.png`), and in a state (for `merge` and `pathlight denoise`).
+    #[arg(long, value_enum, value_delimiter = ',', value_name = "albedo,normal")]
+    pub aov: Vec<Aov>,
+    /// Write the image denoised by Open Image Denoise, guided by the albedo and normal
+    /// (rendered for it); an EXR keeps the raw image as the layer `noisy`. Needs OIDN 2
+    /// (`tools/get-oidn.sh`); refused before rendering without it.
+    #[arg(long, value_enum, value_name = "MODE", num_args = 0..=1, default_missing_value = "final")]
+    pub denoise: Option<DenoiseMode>,
+}
+
+/// Options of `pathlight denoise`.
+#[derive(Debug, clap::Args)]
+pub struct DenoiseArgs {
+    /// An EXR (its `R`, `G`, `B`, with `albedo.*` and `normal.*` layers when it has them,
+    /// as `render --aov albedo,normal` writes) or a state file (`render -o X.state`,
+    /// `merge -o X.state`).
+    pub input: PathBuf,
+    /// The denoised image (`.png`, `.exr`; an EXR keeps the raw image as the layer
+    /// `noisy`).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// How hard the denoiser works.
+    #[arg(long, value_enum, default_value_t = DenoiseMode::Final)]
+    pub mode: DenoiseMode,
+    /// Also write the input's auxiliary images (as `render --aov` does).
+    #[arg(long, value_enum, value_delimiter = ',', value_name = "albedo,normal")]
+    pub aov: Vec<Aov>,
 }
 
 /// Options of `pathlight merge`.
@@ -172,6 +236,10 @@ pub struct MergeArgs {
     /// the parts hold).
     #[arg(long)]
     pub allow_gaps: bool,
+    /// Also write the parts' auxiliary images (rendered with `--aov`), as `render --aov`
+    /// does.
+    #[arg(long, value_enum, value_delimiter = ',', value_name = "albedo,normal")]
+    pub aov: Vec<Aov>,
 }
 
 /// How the nearest hit is found (`pathlight bench --accel`).

@@ -5,6 +5,7 @@ mod note;
 mod backend;
 mod bench;
 mod cli;
+mod denoise;
 mod merge;
 mod output;
 mod progress;
@@ -27,6 +28,7 @@ fn main() -> ExitCode {
         Some(cli::Command::View(args)) => view::run(&args),
         Some(cli::Command::Bench(args)) => bench::run(&args),
         Some(cli::Command::Merge(args)) => merge::run(&args),
+        Some(cli::Command::Denoise(args)) => denoise::run(&args),
         None => view::run(&cli::ViewArgs::defaults()),
     };
     match result {

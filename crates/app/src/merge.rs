@@ -5,7 +5,7 @@ use anyhow::bail;
 use pathlight_core::state::merge;
 
 use crate::cli::MergeArgs;
-use crate::output;
+use crate::{denoise, output};
 
 /// Runs the command.
 pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
@@ -47,7 +47,8 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
     if is_state {
         output::write_render(&merged.into_state()?, &args.output)?;
     } else {
-        output::write(&film, &args.output)?;
+        let images = denoise::images(film.clone(), merged.aov_films(), None, &args.aov)?;
+        output::write_images(&images, &args.output)?;
     }
     note!(
         "merged {} parts into {}: {}x{}, {} spp",

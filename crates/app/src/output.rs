@@ -1,5 +1,6 @@
-//! Writing the film: PNG (sRGB curve, clamped) or EXR (linear float RGB), or the render's
-//! state (its exact sums, `docs/state-format.md`), by extension.
+//! Writing the film: PNG (sRGB curve, clamped) or EXR (linear float RGB, with the auxiliary
+//! images and a denoised image's raw one as layers), or the render's state (its exact sums,
+//! `docs/state-format.md`), by extension.
 //!
 //! An existing file is replaced only by a complete image: the image is encoded in memory,
 //! written to a temporary file beside the target, flushed to the disk, and renamed over the
@@ -10,8 +11,11 @@ use std::path::Path;
 
 use anyhow::{Context, bail};
 use pathlight_core::Film;
+use pathlight_core::film::ExrLayer;
 use pathlight_core::state::RenderState;
 use pathlight_scene::texture::linear_to_srgb;
+
+use crate::cli::Aov;
 
 /// File formats pathlight writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -64,26 +68,29 @@ pub fn check_writable(path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// `film` as an 8-bit PNG, each channel mapped by `encode`.
+fn encode_png(film: &Film, encode: impl Fn(f32) -> f32) -> anyhow::Result<Vec<u8>> {
+    use image::ImageEncoder as _;
+    let pixels: Vec<u8> = film
+        .pixels
+        .iter()
+        .flat_map(|p| p.map(|c| (encode(c).clamp(0.0, 1.0) * 255.0 + 0.5) as u8))
+        .collect();
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes).write_image(
+        &pixels,
+        film.width,
+        film.height,
+        image::ExtendedColorType::Rgb8,
+    )?;
+    Ok(bytes)
+}
+
 /// The film encoded in `format` (an image format).
 fn encode(film: &Film, format: Format) -> anyhow::Result<Vec<u8>> {
     match format {
         Format::State => bail!("a film has no state: only a render's sums make one"),
-        Format::Png => {
-            use image::ImageEncoder as _;
-            let pixels: Vec<u8> = film
-                .pixels
-                .iter()
-                .flat_map(|p| p.map(|c| (linear_to_srgb(c) * 255.0 + 0.5) as u8))
-                .collect();
-            let mut bytes = Vec::new();
-            image::codecs::png::PngEncoder::new(&mut bytes).write_image(
-                &pixels,
-                film.width,
-                film.height,
-                image::ExtendedColorType::Rgb8,
-            )?;
-            Ok(bytes)
-        }
+        Format::Png => encode_png(film, linear_to_srgb),
         Format::Exr => Ok(film.encode_exr()?),
     }
 }
@@ -115,6 +122,88 @@ pub fn write_render(state: &RenderState, path: &Path) -> anyhow::Result<()> {
             .with_context(|| format!("cannot encode {}", path.display()))?,
     };
     replace_file(path, &bytes).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// A finished picture and the images written with it.
+#[derive(Debug, Clone)]
+pub struct Images {
+    /// The picture (denoised where asked).
+    pub image: Film,
+    /// The raw picture when `image` is denoised: an EXR keeps it as the layer `noisy`.
+    pub noisy: Option<Film>,
+    /// Auxiliary images to write beside it.
+    pub aovs: Vec<(Aov, Film)>,
+}
+
+impl Images {
+    /// The picture alone.
+    pub fn plain(image: Film) -> Self {
+        Self {
+            image,
+            noisy: None,
+            aovs: Vec::new(),
+        }
+    }
+}
+
+/// Writes `images` to `path` (`.png` or `.exr`): an EXR holds them all as layers (`noisy.R`,
+/// `albedo.R`, `normal.X`, ...); a PNG holds the picture, each auxiliary image going to a
+/// PNG beside it (`out.albedo.png`: the albedo sRGB-encoded, the normal as `(n + 1) / 2`),
+/// the raw picture nowhere. Every file is replaced only once it is whole on the disk.
+pub fn write_images(images: &Images, path: &Path) -> anyhow::Result<()> {
+    let format = format_of(path)?;
+    let cannot_encode = || format!("cannot encode {}", path.display());
+    match format {
+        Format::State => bail!(
+            "output {}: a state holds a render's sums, not an image",
+            path.display()
+        ),
+        Format::Exr => {
+            let mut layers = Vec::new();
+            if let Some(noisy) = &images.noisy {
+                layers.push(ExrLayer {
+                    name: "noisy",
+                    channels: ["R", "G", "B"],
+                    film: noisy,
+                });
+            }
+            for (aov, film) in &images.aovs {
+                layers.push(ExrLayer {
+                    name: aov.name(),
+                    channels: match aov {
+                        Aov::Albedo => ["R", "G", "B"],
+                        Aov::Normal => ["X", "Y", "Z"],
+                    },
+                    film,
+                });
+            }
+            let bytes = images
+                .image
+                .encode_exr_layers(&layers)
+                .with_context(cannot_encode)?;
+            replace_file(path, &bytes).with_context(|| format!("cannot write {}", path.display()))
+        }
+        Format::Png => {
+            for (aov, film) in &images.aovs {
+                let sibling = sibling_path(path, aov.name());
+                let bytes = match aov {
+                    Aov::Albedo => encode_png(film, linear_to_srgb),
+                    Aov::Normal => encode_png(film, |n| (n + 1.0) * 0.5),
+                }
+                .with_context(|| format!("cannot encode {}", sibling.display()))?;
+                replace_file(&sibling, &bytes)
+                    .with_context(|| format!("cannot write {}", sibling.display()))?;
+            }
+            write(&images.image, path)
+        }
+    }
+}
+
+/// `out.png` with `name` before its extension: `out.albedo.png`.
+pub fn sibling_path(path: &Path, name: &str) -> std::path::PathBuf {
+    let stem = path.file_stem().unwrap_or_default().to_string_lossy();
+    let extension = path.extension().unwrap_or_default().to_string_lossy();
+    path.with_file_name(format!("{stem}.{name}.{extension}"))
 }
 
 /// Reads the render state in `path`, naming the file in every error.

@@ -8,6 +8,7 @@ use std::time::Instant;
 use anyhow::{Context, bail};
 use pathlight_core::state::{Fingerprint, RenderState};
 use pathlight_core::{Accumulation, PreparedScene, Renderer};
+use pathlight_denoise::{Denoiser, Mode};
 use pathlight_gpu::Accel;
 use pathlight_gpu::context::{available_adapters, describe};
 use pathlight_scene::Scene;
@@ -15,6 +16,7 @@ use pathlight_scene::settings::check_spp;
 
 use crate::backend::{Device, load_scene};
 use crate::cli::RenderArgs;
+use crate::denoise;
 use crate::output;
 use crate::progress::Progress;
 use crate::shard::part_of;
@@ -52,6 +54,20 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     }
     check_spp(scene.settings.spp)?;
     output::check_writable(&args.output)?;
+    let to_state = output::format_of(&args.output)? == output::Format::State;
+    if args.denoise.is_some() && to_state {
+        bail!(
+            "--denoise writes an image, not a state: render to {} without it and denoise              later with `pathlight denoise {}` (give the render --aov albedo,normal to guide it)",
+            args.output.display(),
+            args.output.display()
+        );
+    }
+    scene.settings.aovs = args.denoise.is_some() || !args.aov.is_empty();
+    // Without OIDN, refused before rendering.
+    let denoiser = match args.denoise {
+        Some(mode) => Some((denoise::load()?, denoise::mode(mode))),
+        None => None,
+    };
     if let Some(checkpoint) = &args.checkpoint {
         if output::format_of(checkpoint).ok() != Some(output::Format::State) {
             bail!(
@@ -61,7 +77,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         }
         output::check_writable(checkpoint)?;
     }
-    render_to_file(&scene, args, &interrupted)
+    render_to_file(
+        &scene,
+        args,
+        &interrupted,
+        denoiser.as_ref().map(|(d, m)| (d, *m)),
+    )
 }
 
 /// What a render starts from: the samples it is asked for and the sums it already has.
@@ -135,7 +156,7 @@ fn start(scene: &Scene, args: &RenderArgs, fingerprint: &Fingerprint) -> anyhow:
         (None, None) => 0..spp,
     };
     Ok(Start {
-        accumulation: Accumulation::empty(width, height, target.start),
+        accumulation: Accumulation::empty(width, height, target.start, scene.settings.aovs),
         target,
     })
 }
@@ -151,6 +172,7 @@ fn render_to_file(
     scene: &Scene,
     args: &RenderArgs,
     interrupted: &AtomicBool,
+    denoiser: Option<(&Denoiser, Mode)>,
 ) -> anyhow::Result<()> {
     let started = Instant::now();
     let prepared = PreparedScene::new(scene)?;
@@ -214,6 +236,8 @@ fn render_to_file(
     }
     progress.finish();
     let render_time = render_started.elapsed();
+    let spp = renderer.samples_done();
+    let samples_per_second = progress.samples_per_second(spp);
     let state = state_of(renderer.as_ref())?;
     let dropped = renderer.samples_dropped()?;
     if dropped > 0 {
@@ -226,7 +250,6 @@ fn render_to_file(
         output::write_render(&state, checkpoint)?;
         note!("checkpoint {} written", checkpoint.display());
     }
-    let spp = renderer.samples_done();
     let has_samples = spp > 0 || state.rows.iter().any(|r| !r.is_empty());
     if !has_samples && stop.is_some() {
         note!("stopped before the first sample; no image written");
@@ -235,7 +258,12 @@ fn render_to_file(
             _ => Ok(()),
         };
     }
-    output::write_render(&state, &args.output)?;
+    if output::format_of(&args.output)? == output::Format::State {
+        output::write_render(&state, &args.output)?;
+    } else {
+        let images = denoise::images(state.film(), state.aov_films(), denoiser, &args.aov)?;
+        output::write_images(&images, &args.output)?;
+    }
     match stop {
         Some(Stop::Signal) => note!(
             "interrupted: kept {spp} of {total} spp (rows already sampled in the pass under way \
@@ -254,7 +282,7 @@ fn render_to_file(
         first_sample,
         first_sample + spp,
         render_time.as_secs_f64(),
-        progress.samples_per_second(spp) / 1e6,
+        samples_per_second / 1e6,
         started.elapsed().as_secs_f64()
     );
     if stop == Some(Stop::Signal) {

@@ -60,6 +60,9 @@ fn merges_of_any_split_equal_the_one_machine_render() {
     let dir = tempfile::tempdir().unwrap();
     let whole = path(dir.path(), "whole.exr");
     render(&["--spp", "7", "-o", &whole]);
+    // With the auxiliary images too (the EXR's albedo and normal layers).
+    let whole_aovs = path(dir.path(), "whole-aovs.exr");
+    render(&["--spp", "7", "--aov", "albedo,normal", "-o", &whole_aovs]);
     for count in [1, 2, 3, 7] {
         let parts: Vec<String> = (0..count)
             .map(|i| {
@@ -67,6 +70,8 @@ fn merges_of_any_split_equal_the_one_machine_render() {
                 render(&[
                     "--spp",
                     "7",
+                    "--aov",
+                    "albedo,normal",
                     "--shard",
                     &format!("{i}/{count}"),
                     "-o",
@@ -75,6 +80,16 @@ fn merges_of_any_split_equal_the_one_machine_render() {
                 part
             })
             .collect();
+        let merged_aovs = path(dir.path(), &format!("merged-aovs{count}.exr"));
+        let mut args = vec!["merge", "--aov", "albedo,normal"];
+        args.extend(parts.iter().map(String::as_str));
+        args.extend(["-o", &merged_aovs]);
+        let output = pathlight(&args);
+        assert!(output.status.success(), "{}", stderr(&output));
+        assert!(
+            bytes(&merged_aovs) == bytes(&whole_aovs),
+            "{count} parts, AOVs"
+        );
         let merged = path(dir.path(), &format!("merged{count}.exr"));
         let mut args = vec!["merge"];
         args.extend(parts.iter().map(String::as_str));

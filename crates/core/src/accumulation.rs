@@ -5,7 +5,7 @@
 use std::ops::Range;
 
 use crate::error::RenderError;
-use crate::gpu_types::GpuAccumPixel;
+use crate::gpu_types::{GpuAccumPixel, GpuAovPixel};
 
 /// Which samples a render's pixels hold: from sample `first_sample`, `samples` whole passes
 /// (one sample of every pixel each), and the pass under way in rows `0 .. rows_ahead`.
@@ -77,20 +77,40 @@ pub struct Accumulation {
     pub cursor: SampleCursor,
     /// The fixed-point sums, row by row.
     pub sums: Vec<GpuAccumPixel>,
+    /// The auxiliary images' sums from the same samples, row by row; empty for a render
+    /// without them.
+    pub aovs: Vec<GpuAovPixel>,
 }
 
 impl Accumulation {
-    /// No sample yet: the image empty, its first sample `first_sample`.
-    pub fn empty(width: u32, height: u32, first_sample: u32) -> Self {
+    /// No sample yet: the image empty (with empty auxiliary images when `aovs`), its first
+    /// sample `first_sample`.
+    pub fn empty(width: u32, height: u32, first_sample: u32, aovs: bool) -> Self {
+        let pixels = (width * height) as usize;
         Self {
             cursor: SampleCursor::starting_at(first_sample),
-            sums: vec![GpuAccumPixel::default(); (width * height) as usize],
+            sums: vec![GpuAccumPixel::default(); pixels],
+            aovs: vec![GpuAovPixel::default(); if aovs { pixels } else { 0 }],
         }
     }
 
-    /// Refuses sums that do not fit a `width` x `height` image.
-    pub fn check_fits(&self, width: u32, height: u32) -> Result<(), RenderError> {
+    /// Whether it holds the auxiliary images.
+    pub fn has_aovs(&self) -> bool {
+        !self.aovs.is_empty()
+    }
+
+    /// Refuses sums that do not fit a `width` x `height` image rendered with auxiliary
+    /// images or without (`aovs`).
+    pub fn check_fits(&self, width: u32, height: u32, aovs: bool) -> Result<(), RenderError> {
         let pixels = width as usize * height as usize;
+        if self.has_aovs() != aovs || (aovs && self.aovs.len() != pixels) {
+            let has = |yes: bool| if yes { "with" } else { "without" };
+            return Err(RenderError::Resume(format!(
+                "sums {} auxiliary images do not fit a render {} them",
+                has(self.has_aovs()),
+                has(aovs)
+            )));
+        }
         let c = &self.cursor;
         if self.sums.len() != pixels || (c.in_pass() && c.rows_ahead >= height) {
             return Err(RenderError::Resume(format!(

@@ -2,7 +2,18 @@
 //! sums, read from and written to OpenEXR, and compared with a reference.
 
 use crate::accumulation::{Accumulation, SampleCursor};
-use crate::gpu_types::GpuAccumPixel;
+use crate::gpu_types::{GpuAccumPixel, GpuAovPixel};
+
+/// An image written beside a film's in one OpenEXR file ([`Film::encode_exr_layers`]).
+#[derive(Debug, Clone, Copy)]
+pub struct ExrLayer<'a> {
+    /// The layer's name (`albedo`).
+    pub name: &'a str,
+    /// Its three channels' names (`R`, `G`, `B`, or `X`, `Y`, `Z` for a normal).
+    pub channels: [&'a str; 3],
+    /// The image, of the film's size.
+    pub film: &'a Film,
+}
 
 /// Mean linear RGB radiance per pixel, row 0 at the top.
 #[derive(Debug, Clone, PartialEq)]
@@ -53,6 +64,41 @@ impl Film {
             spp: counts.iter().copied().min().unwrap_or(0),
             pixels,
         }
+    }
+
+    /// The auxiliary images of a render's accumulation, albedo then shading normal (each
+    /// pixel the mean of its samples), if it has them.
+    pub fn aovs_from_accumulation(
+        width: u32,
+        height: u32,
+        accumulation: &Accumulation,
+    ) -> Option<(Self, Self)> {
+        let counts: Vec<u32> = (0..height)
+            .map(|y| accumulation.cursor.row_samples(y))
+            .collect();
+        Self::aovs_from_row_sums(width, &counts, &accumulation.aovs)
+    }
+
+    /// The auxiliary images, albedo then shading normal, of sums where row `y` holds
+    /// `counts[y]` samples per pixel; `None` for no sums.
+    pub fn aovs_from_row_sums(
+        width: u32,
+        counts: &[u32],
+        aovs: &[GpuAovPixel],
+    ) -> Option<(Self, Self)> {
+        if aovs.is_empty() {
+            return None;
+        }
+        let albedo: Vec<GpuAccumPixel> = aovs.iter().map(|a| a.albedo).collect();
+        let normal: Vec<GpuAccumPixel> = aovs.iter().map(|a| a.normal).collect();
+        let mut normal = Self::from_row_sums(width, counts, &normal);
+        // Accumulated as (n + 1) / 2; a pixel without samples has no normal.
+        for (i, p) in normal.pixels.iter_mut().enumerate() {
+            if counts[i / width as usize] > 0 {
+                *p = p.map(|c| 2.0 * c - 1.0);
+            }
+        }
+        Some((Self::from_row_sums(width, counts, &albedo), normal))
     }
 
     /// The pixel at column `x`, row `y`.
@@ -116,6 +162,85 @@ impl Film {
             .write()
             .to_buffered(std::io::Cursor::new(&mut bytes))?;
         Ok(bytes)
+    }
+
+    /// The film as an OpenEXR file in memory whose main channels `R`, `G`, `B` are this
+    /// film and whose other channels are `layers`' (`albedo.R`, `normal.X`, ...: Blender's
+    /// and Cycles' naming), all 32-bit float, one part.
+    pub fn encode_exr_layers(&self, layers: &[ExrLayer]) -> Result<Vec<u8>, exr::error::Error> {
+        use exr::prelude::*;
+        let plane =
+            |film: &Film, c: usize| FlatSamples::F32(film.pixels.iter().map(|p| p[c]).collect());
+        let mut channels: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+        for (c, name) in ["R", "G", "B"].into_iter().enumerate() {
+            channels.push(AnyChannel::new(name, plane(self, c)));
+        }
+        for layer in layers {
+            assert_eq!(
+                (layer.film.width, layer.film.height),
+                (self.width, self.height),
+                "a layer has the film's size"
+            );
+            for (c, name) in layer.channels.into_iter().enumerate() {
+                let full = format!("{}.{name}", layer.name);
+                channels.push(AnyChannel::new(full.as_str(), plane(layer.film, c)));
+            }
+        }
+        let encoding = Encoding {
+            line_order: LineOrder::Increasing,
+            ..Encoding::FAST_LOSSLESS
+        };
+        let size = (self.width as usize, self.height as usize);
+        let layer = Layer::new(
+            size,
+            LayerAttributes::default(),
+            encoding,
+            AnyChannels::sort(channels),
+        );
+        let mut bytes = Vec::new();
+        Image::from_layer(layer)
+            .write()
+            .to_buffered(std::io::Cursor::new(&mut bytes))?;
+        Ok(bytes)
+    }
+
+    /// Reads an OpenEXR file's main `R`, `G`, `B` channels and, for each of `wanted` (a
+    /// layer's name and channel names), that layer when the file has all its channels.
+    pub fn read_exr_layers(
+        path: &std::path::Path,
+        wanted: &[(&str, [&str; 3])],
+    ) -> Result<(Self, Vec<Option<Self>>), exr::error::Error> {
+        use exr::prelude::*;
+        let image = read_first_flat_layer_from_file(path)?;
+        let layer = &image.layer_data;
+        let size = layer.size;
+        let find = |name: &str| {
+            layer
+                .channel_data
+                .list
+                .iter()
+                .find(|c| c.name.eq(name))
+                .map(|c| &c.sample_data)
+        };
+        let film = |names: [String; 3]| -> Option<Self> {
+            let planes: Vec<&FlatSamples> = names.iter().map(|n| find(n)).collect::<Option<_>>()?;
+            let pixels = (0..size.area())
+                .map(|i| [0, 1, 2].map(|c| planes[c].value_by_flat_index(i).to_f32()))
+                .collect();
+            Some(Self {
+                width: size.width() as u32,
+                height: size.height() as u32,
+                spp: 0,
+                pixels,
+            })
+        };
+        let main = film(["R", "G", "B"].map(String::from))
+            .ok_or_else(|| exr::error::Error::Invalid("it has no R, G and B channels".into()))?;
+        let layers = wanted
+            .iter()
+            .map(|(name, channels)| film(channels.map(|c| format!("{name}.{c}"))))
+            .collect();
+        Ok((main, layers))
     }
 
     /// Box-downsamples by an integer `factor` (each output pixel is the mean of a

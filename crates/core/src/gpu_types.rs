@@ -325,8 +325,8 @@ pub struct GpuRenderParams {
     pub env_height: u32,
     /// Factor from decoded environment texels to radiance.
     pub env_scale: f32,
-    /// Padding.
-    pub pad0: u32,
+    /// 1: the passes also accumulate the auxiliary images ([`GpuAovPixel`]); 0: not.
+    pub aovs: u32,
     /// Cosine and sine of the map's turn about +y.
     pub env_rotation: [f32; 2],
     /// Padding.
@@ -370,3 +370,26 @@ impl GpuAccumPixel {
     }
 }
 const _: () = assert!(size_of::<GpuAccumPixel>() == 32);
+
+/// One pixel of the auxiliary images a denoiser reads, accumulated like the colour (a sum
+/// per channel in [`GpuAccumPixel`]'s fixed point) from the same samples: per sample, the
+/// albedo (in [0, 1]) and the shading normal mapped from [-1, 1] to `(n + 1) / 2`, both of
+/// the first surface a path meets that is not a perfect mirror or glass (ARCHITECTURE.md,
+/// "Auxiliary images"). WGSL: `AovPixel`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuAovPixel {
+    /// Sums of the albedo.
+    pub albedo: GpuAccumPixel,
+    /// Sums of the normal, as `(n + 1) / 2`.
+    pub normal: GpuAccumPixel,
+}
+const _: () = assert!(size_of::<GpuAovPixel>() == 64);
+
+impl GpuAovPixel {
+    /// `self += other`, both images, exactly (see [`GpuAccumPixel::accumulate`]).
+    pub fn accumulate(&mut self, other: &Self) {
+        self.albedo.accumulate(&other.albedo);
+        self.normal.accumulate(&other.normal);
+    }
+}

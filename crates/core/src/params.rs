@@ -33,6 +33,7 @@ impl GpuRenderParams {
             rr_depth: settings.rr_depth,
             seed: settings.seed,
             sampler: sampler_code(settings.sampler),
+            aovs: u32::from(settings.aovs),
             ..Self::zeroed_params()
         };
         params.set_shading(shading);

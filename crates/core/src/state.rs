@@ -11,13 +11,15 @@ use sha2::{Digest, Sha256};
 
 use crate::accumulation::{Accumulation, SampleCursor};
 use crate::film::Film;
-use crate::gpu_types::{GpuAccumPixel, GpuCamera};
+use crate::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuCamera};
 use crate::prepared::PreparedScene;
 
 /// The first bytes of every state file.
 pub const MAGIC: &[u8; 16] = b"pathlight-state\n";
 /// The format version this build reads and writes.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
+/// Names of the auxiliary images a state holds when it holds them (in file order).
+pub const AOV_NAMES: [&str; 2] = ["albedo", "normal"];
 /// Bytes of the checksum that ends the file (SHA-256).
 const CHECKSUM: usize = 32;
 /// Bytes before the header: magic, version, header length.
@@ -44,6 +46,8 @@ pub struct Fingerprint {
     pub max_depth: u32,
     /// Depth from which Russian roulette applies.
     pub rr_depth: u32,
+    /// The auxiliary images accumulated with the colour: [`AOV_NAMES`], or none.
+    pub aovs: Vec<String>,
 }
 
 /// SHA-256 of `parts` in turn, as lowercase hex.
@@ -99,7 +103,17 @@ impl Fingerprint {
             .into(),
             max_depth: settings.max_depth,
             rr_depth: settings.rr_depth,
+            aovs: if settings.aovs {
+                AOV_NAMES.map(String::from).to_vec()
+            } else {
+                Vec::new()
+            },
         }
+    }
+
+    /// Whether the render accumulates the auxiliary images.
+    pub fn has_aovs(&self) -> bool {
+        !self.aovs.is_empty()
     }
 
     /// What differs between `self` and `other`, called `names.0` and `names.1`, one phrase
@@ -125,6 +139,11 @@ impl Fingerprint {
             self.rr_depth.to_string(),
             other.rr_depth.to_string(),
         );
+        let aovs = |f: &Self| match f.aovs.is_empty() {
+            true => "none".to_owned(),
+            false => f.aovs.join(","),
+        };
+        differ("auxiliary images", aovs(self), aovs(other));
         if self.camera != other.camera {
             out.push("the camera differs".into());
         }
@@ -175,6 +194,8 @@ pub struct RenderState {
     pub rows: Vec<Range<u32>>,
     /// The fixed-point sums, row by row.
     pub sums: Vec<GpuAccumPixel>,
+    /// The auxiliary images' sums, row by row (empty when the fingerprint has none).
+    pub aovs: Vec<GpuAovPixel>,
 }
 
 impl RenderState {
@@ -196,6 +217,7 @@ impl RenderState {
             backend,
             rows,
             sums: accumulation.sums,
+            aovs: accumulation.aovs,
         }
     }
 
@@ -238,13 +260,23 @@ impl RenderState {
                 rows_ahead: ahead as u32,
             },
             sums: self.sums.clone(),
+            aovs: self.aovs.clone(),
         })
     }
 
     /// The image: each pixel the mean of the samples its row holds.
     pub fn film(&self) -> Film {
-        let counts: Vec<u32> = self.rows.iter().map(|r| r.len() as u32).collect();
-        Film::from_row_sums(self.fingerprint.width, &counts, &self.sums)
+        Film::from_row_sums(self.fingerprint.width, &self.counts(), &self.sums)
+    }
+
+    /// The auxiliary images (albedo, normal) of the same samples, if it has them.
+    pub fn aov_films(&self) -> Option<(Film, Film)> {
+        Film::aovs_from_row_sums(self.fingerprint.width, &self.counts(), &self.aovs)
+    }
+
+    /// Per row, the samples each of its pixels holds.
+    fn counts(&self) -> Vec<u32> {
+        self.rows.iter().map(|r| r.len() as u32).collect()
     }
 
     /// The file's bytes (see the module documentation).
@@ -256,7 +288,12 @@ impl RenderState {
         };
         let json = serde_json::to_vec(&header).expect("the header serialises");
         let mut bytes = Vec::with_capacity(
-            PREAMBLE + json.len() + self.rows.len() * 8 + self.sums.len() * 32 + CHECKSUM,
+            PREAMBLE
+                + json.len()
+                + self.rows.len() * 8
+                + self.sums.len() * 32
+                + self.aovs.len() * 64
+                + CHECKSUM,
         );
         bytes.extend_from_slice(MAGIC);
         bytes.extend_from_slice(&VERSION.to_le_bytes());
@@ -266,7 +303,8 @@ impl RenderState {
             bytes.extend_from_slice(&row.start.to_le_bytes());
             bytes.extend_from_slice(&row.end.to_le_bytes());
         }
-        for sum in &self.sums {
+        let aov_sums = self.aovs.iter().flat_map(|a| [&a.albedo, &a.normal]);
+        for sum in self.sums.iter().chain(aov_sums) {
             for word in sum.hi.iter().chain(&sum.lo) {
                 bytes.extend_from_slice(&word.to_le_bytes());
             }
@@ -289,8 +327,13 @@ impl RenderState {
         let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().expect("4 bytes"));
         let version = word(16);
         if version != VERSION {
+            let why = if version == 1 {
+                " (written before states held auxiliary images): render it again"
+            } else {
+                ""
+            };
             return Err(StateError::Foreign(format!(
-                "format version {version}; this pathlight reads version {VERSION}"
+                "format version {version}; this pathlight reads version {VERSION}{why}"
             )));
         }
         let (body, checksum) = bytes.split_at(bytes.len() - CHECKSUM);
@@ -309,13 +352,21 @@ impl RenderState {
         let (width, height) = (header.fingerprint.width, header.fingerprint.height);
         check_resolution(width, height)
             .map_err(|err| StateError::Corrupt(format!("the header: {err}")))?;
+        let aovs = &header.fingerprint.aovs;
+        if !aovs.is_empty() && *aovs != AOV_NAMES {
+            return Err(StateError::Corrupt(format!(
+                "the header names auxiliary images {aovs:?}; a state holds {AOV_NAMES:?} or none"
+            )));
+        }
+        let pixels = width as usize * height as usize;
         let rows_len = height as usize * 8;
-        let sums_len = width as usize * height as usize * 32;
-        if body.len() - header_end != rows_len + sums_len {
+        let sums_len = pixels * 32;
+        let aovs_len = if aovs.is_empty() { 0 } else { pixels * 64 };
+        if body.len() - header_end != rows_len + sums_len + aovs_len {
             return Err(StateError::Corrupt(format!(
                 "{} bytes of rows and sums where {width}x{height} needs {}",
                 body.len() - header_end,
-                rows_len + sums_len
+                rows_len + sums_len + aovs_len
             )));
         }
         let target = header.target[0]..header.target[1];
@@ -327,12 +378,18 @@ impl RenderState {
                 "a sample range ends before it starts".into(),
             ));
         }
-        let sum_words: Vec<u32> = words(header_end + rows_len, sums_len / 4).collect();
-        let sums = sum_words
-            .chunks(8)
-            .map(|w| GpuAccumPixel {
-                hi: [w[0], w[1], w[2], w[3]],
-                lo: [w[4], w[5], w[6], w[7]],
+        let sum_words: Vec<u32> = words(header_end + rows_len, (sums_len + aovs_len) / 4).collect();
+        let mut all = sum_words.chunks(8).map(|w| GpuAccumPixel {
+            hi: [w[0], w[1], w[2], w[3]],
+            lo: [w[4], w[5], w[6], w[7]],
+        });
+        let sums = all.by_ref().take(pixels).collect();
+        let aov_sums: Vec<GpuAccumPixel> = all.collect();
+        let aovs = aov_sums
+            .chunks(2)
+            .map(|p| GpuAovPixel {
+                albedo: p[0],
+                normal: p[1],
             })
             .collect();
         Ok(Self {
@@ -341,6 +398,7 @@ impl RenderState {
             backend: header.backend,
             rows,
             sums,
+            aovs,
         })
     }
 }
@@ -362,6 +420,11 @@ impl Merged {
     /// The image: each pixel the mean of the samples every part holds for it.
     pub fn film(&self) -> Film {
         Film::from_row_sums(self.state.fingerprint.width, &self.counts, &self.state.sums)
+    }
+
+    /// The auxiliary images (albedo, normal) of the same samples, if the parts have them.
+    pub fn aov_films(&self) -> Option<(Film, Film)> {
+        Film::aovs_from_row_sums(self.state.fingerprint.width, &self.counts, &self.state.aovs)
     }
 
     /// The merged state, refused where a row's samples have a gap (a state holds one range
@@ -403,8 +466,12 @@ pub fn merge(parts: &[(String, RenderState)]) -> Result<Merged, StateError> {
     let target = parts.iter().map(|(_, p)| p.target.start).min().unwrap_or(0)
         ..parts.iter().map(|(_, p)| p.target.end).max().unwrap_or(0);
     let mut sums = vec![GpuAccumPixel::default(); first.sums.len()];
+    let mut aovs = vec![GpuAovPixel::default(); first.aovs.len()];
     for (_, part) in parts {
         for (sum, add) in sums.iter_mut().zip(&part.sums) {
+            sum.accumulate(add);
+        }
+        for (sum, add) in aovs.iter_mut().zip(&part.aovs) {
             sum.accumulate(add);
         }
     }
@@ -466,6 +533,7 @@ pub fn merge(parts: &[(String, RenderState)]) -> Result<Merged, StateError> {
             backend: first.backend.clone(),
             rows,
             sums,
+            aovs,
         },
         counts,
         missing,
@@ -486,6 +554,7 @@ mod tests {
             sampler: "sobol".into(),
             max_depth: 8,
             rr_depth: 4,
+            aovs: Vec::new(),
         }
     }
 
@@ -510,6 +579,7 @@ mod tests {
                 rows_ahead,
             },
             sums,
+            aovs: Vec::new(),
         };
         RenderState::new(fingerprint(3, 2), target, "test".into(), accumulation)
     }
@@ -555,7 +625,7 @@ mod tests {
         last.rows = vec![u32::MAX - 1..u32::MAX, u32::MAX - 1..u32::MAX];
         let read = RenderState::decode(&last.encode()).unwrap();
         let accumulation = read.accumulation().unwrap();
-        assert!(accumulation.check_fits(3, 2).is_err());
+        assert!(accumulation.check_fits(3, 2, false).is_err());
         last.rows = vec![u32::MAX - 1..u32::MAX, u32::MAX - 2..u32::MAX - 1];
         assert!(
             last.accumulation().is_err(),

@@ -2,7 +2,7 @@
 //! `integrator.wgsl` (same loop, same order of sample dimensions).
 
 use glam::Vec3A;
-use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams, NO_LIGHT};
+use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams, NO_LIGHT};
 
 use crate::bvh::Hit;
 use crate::camera::camera_ray;
@@ -11,7 +11,9 @@ use crate::environment::{env_pdf, env_radiance};
 use crate::intersect::Ray;
 use crate::light_sample::LightSample;
 use crate::lights::{light_pdf, sample_light};
-use crate::material::{eval_material, has_continuous_material_lobe, material_at, sample_material};
+use crate::material::{
+    eval_material, has_continuous_material_lobe, material_albedo, material_at, sample_material,
+};
 use crate::sampler::{Draw, Sampler};
 use crate::sampling::power_heuristic;
 use crate::surface::surface_at;
@@ -48,11 +50,17 @@ fn shadow_ray(p: Vec3A, ng: Vec3A, ls: &LightSample) -> (Ray, f32) {
     )
 }
 
-/// What one camera path brought back.
+/// What one camera path brought back. Twin of WGSL `PathResult`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PathSample {
     /// Radiance along the path.
     pub radiance: Vec3A,
+    /// With auxiliary images: the albedo of the first surface it met that is not a perfect
+    /// mirror or glass (through those, weighted by what they pass on).
+    pub albedo: Vec3A,
+    /// With auxiliary images: that surface's shading normal (zero where the path escaped
+    /// at once).
+    pub normal: Vec3A,
     /// Rays traced for it (camera, extension and shadow rays).
     pub rays: u32,
 }
@@ -92,6 +100,10 @@ pub struct Path {
     /// Product of the relative IORs crossed: throughput * eta_scale^2 is the throughput
     /// without the 1/eta^2 radiance scaling, which Russian roulette should see.
     eta_scale: f32,
+    /// The auxiliary images are still looking for their surface.
+    aov_pending: bool,
+    /// The weight of the perfect mirrors and glass passed through so far.
+    aov_weight: Vec3A,
 }
 
 impl Path {
@@ -104,6 +116,8 @@ impl Path {
             alive: params.max_depth > 0,
             sample: PathSample {
                 radiance: Vec3A::ZERO,
+                albedo: Vec3A::ZERO,
+                normal: Vec3A::ZERO,
                 rays: 0,
             },
             sampler,
@@ -114,6 +128,8 @@ impl Path {
             prev_position: ray.origin.into(),
             prev_normal: Vec3A::ZERO,
             eta_scale: 1.0,
+            aov_pending: params.aovs != 0,
+            aov_weight: Vec3A::ONE,
         }
     }
 
@@ -139,8 +155,12 @@ impl Path {
                     env_pdf(scene, params, self.prev_normal, ray.dir.into()),
                 )
             };
-            self.sample.radiance +=
-                self.throughput * env_radiance(scene, params, ray.dir.into()) * w;
+            let env = env_radiance(scene, params, ray.dir.into());
+            self.sample.radiance += self.throughput * env * w;
+            if self.aov_pending {
+                self.sample.albedo = self.aov_weight * env.clamp(Vec3A::ZERO, Vec3A::ONE);
+                self.aov_pending = false;
+            }
             self.alive = false;
             return None;
         };
@@ -166,8 +186,17 @@ impl Path {
             };
             self.sample.radiance += self.throughput * emission * w;
         }
+        let continuous = has_continuous_material_lobe(material);
+        if self.aov_pending {
+            self.sample.normal = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
+            if continuous {
+                let albedo = material_albedo(material).clamp(Vec3A::ZERO, Vec3A::ONE);
+                self.sample.albedo = self.aov_weight * albedo;
+                self.aov_pending = false;
+            }
+        }
         if self.depth == params.max_depth {
-            self.alive = false;
+            self.end();
             return None;
         }
         // Every bounce draws the same dimensions in the same order.
@@ -183,7 +212,7 @@ impl Path {
             (u_light_select.x, u_lobe.x, u_fresnel.x, u_rr.x);
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
         let mut shadow = None;
-        if has_continuous_material_lobe(material) {
+        if continuous {
             let ls = sample_light(scene, params, s.position, n, u_light_select, u_light);
             if ls.valid {
                 let e = eval_material(material, &s, wo, ls.wi);
@@ -203,8 +232,14 @@ impl Path {
         }
         let bs = sample_material(material, &s, wo, u_lobe, u_fresnel, u_bsdf);
         if !bs.valid {
-            self.alive = false;
+            self.end();
             return shadow;
+        }
+        if self.aov_pending {
+            // A perfect mirror or glass passes on what it reflects or transmits (without
+            // refraction's radiance scaling).
+            let passed = bs.weight * (bs.eta * bs.eta);
+            self.aov_weight *= passed.clamp(Vec3A::ZERO, Vec3A::ONE);
         }
         self.throughput *= bs.weight;
         self.prev_pdf = bs.pdf;
@@ -215,13 +250,24 @@ impl Path {
         if self.depth >= params.rr_depth {
             let q = (self.throughput.max_element() * self.eta_scale * self.eta_scale).min(0.95);
             if u_rr >= q {
-                self.alive = false;
+                self.end();
                 return shadow;
             }
             self.throughput /= q;
         }
         self.ray = Ray::new(offset_origin(s.position, s.ng, bs.wi), bs.wi);
         shadow
+    }
+
+    /// Ends the path on a surface; if the auxiliary images found none but perfect mirrors
+    /// and glass, those count as white.
+    #[inline(always)]
+    fn end(&mut self) {
+        self.alive = false;
+        if self.aov_pending {
+            self.sample.albedo = self.aov_weight;
+            self.aov_pending = false;
+        }
     }
 
     /// Adds the radiance of a [`ShadowTest`] whose ray nothing blocked.
@@ -279,6 +325,25 @@ pub fn add_sample(acc: &mut GpuAccumPixel, value: Vec3A) {
         lo: [frac.x as u32, frac.y as u32, frac.z as u32, 0],
     };
     add_fixed(acc, &sample);
+}
+
+/// `acc +=` the auxiliary images of `sample`: the albedo, and the normal as `(n + 1) / 2`
+/// (an albedo that is not finite counts as zero, such a normal as the zero vector). Twin of
+/// WGSL `add_aov_sample`.
+#[inline(always)]
+pub fn add_aov_sample(acc: &mut GpuAovPixel, sample: &PathSample) {
+    let albedo = if sample.albedo.is_finite() {
+        sample.albedo
+    } else {
+        Vec3A::ZERO
+    };
+    let normal = if sample.normal.is_finite() {
+        (sample.normal + 1.0) * 0.5
+    } else {
+        Vec3A::splat(0.5)
+    };
+    add_sample(&mut acc.albedo, albedo);
+    add_sample(&mut acc.normal, normal);
 }
 
 /// `acc += x` on 64-bit fixed point, saturating instead of wrapping. Twin of WGSL

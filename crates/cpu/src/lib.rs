@@ -30,7 +30,7 @@ pub mod tracer;
 use std::ops::Range;
 use std::time::{Duration, Instant};
 
-use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams};
+use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams};
 use pathlight_core::{
     Accumulation, Film, PreparedScene, RenderError, Renderer, SampleCursor, Shading,
 };
@@ -39,7 +39,7 @@ use rayon::prelude::*;
 
 pub use crate::cpu_scene::CpuScene;
 pub use crate::row::InstructionSet;
-use crate::row::{RowJob, Tally, render_row_with};
+use crate::row::{RowJob, RowSums, Tally, render_row_with};
 pub use crate::tracer::Tracer;
 
 /// Aimed-for duration of one `advance` (for progress reports and interruption).
@@ -55,6 +55,8 @@ pub struct CpuRenderer {
     /// Per pixel, the sum of accumulated samples in the GPU's fixed point (exact, and the
     /// same whatever order they were added in).
     sums: Vec<GpuAccumPixel>,
+    /// Per pixel, the auxiliary images' sums (empty for a render without them).
+    aovs: Vec<GpuAovPixel>,
     /// The samples the sums hold.
     cursor: SampleCursor,
     /// Seconds one sample of one pixel took in the last render (`None` before the first).
@@ -89,6 +91,7 @@ impl CpuRenderer {
             scene: scene.clone(),
             params,
             sums: vec![GpuAccumPixel::default(); pixels],
+            aovs: vec![GpuAovPixel::default(); if settings.aovs { pixels } else { 0 }],
             cursor: SampleCursor::default(),
             pixel_seconds: None,
             tally: Tally::default(),
@@ -118,19 +121,25 @@ impl CpuRenderer {
         let width = params.width as usize;
         let pixels = rows.start as usize * width..rows.end as usize * width;
         let started = Instant::now();
+        let aov_rows: Vec<&mut [GpuAovPixel]> = if self.aovs.is_empty() {
+            rows.clone().map(|_| &mut [][..]).collect()
+        } else {
+            self.aovs[pixels.clone()].chunks_mut(width).collect()
+        };
         let tally = self.sums[pixels.clone()]
             .par_chunks_mut(width)
+            .zip(aov_rows)
             .enumerate()
             .map_init(
                 || Tracer::new(&scene),
-                |tracer, (y, row)| {
+                |tracer, (y, (color, aovs))| {
                     let job = RowJob {
                         scene: &scene,
                         params,
                         y: rows.start + y as u32,
                         samples: offset..offset + samples,
                     };
-                    render_row_with(isa, tracer, &job, row)
+                    render_row_with(isa, tracer, &job, &mut RowSums { color, aovs })
                 },
             )
             .sum::<Tally>();
@@ -182,7 +191,11 @@ impl Renderer for CpuRenderer {
 
     fn set_camera(&mut self, camera: &Camera) -> Result<(), RenderError> {
         self.params.set_camera(camera);
-        self.sums = vec![GpuAccumPixel::default(); (camera.width * camera.height) as usize];
+        let pixels = (camera.width * camera.height) as usize;
+        self.sums = vec![GpuAccumPixel::default(); pixels];
+        if self.params.aovs != 0 {
+            self.aovs = vec![GpuAovPixel::default(); pixels];
+        }
         self.restart();
         Ok(())
     }
@@ -196,6 +209,7 @@ impl Renderer for CpuRenderer {
 
     fn restart(&mut self) {
         self.sums.fill(GpuAccumPixel::default());
+        self.aovs.fill(GpuAovPixel::default());
         self.cursor = SampleCursor::default();
         self.tally = Tally::default();
     }
@@ -248,13 +262,15 @@ impl Renderer for CpuRenderer {
         Ok(Accumulation {
             cursor: self.cursor,
             sums: self.sums.clone(),
+            aovs: self.aovs.clone(),
         })
     }
 
     fn resume(&mut self, from: &Accumulation) -> Result<(), RenderError> {
         let (width, height) = self.size();
-        from.check_fits(width, height)?;
+        from.check_fits(width, height, self.params.aovs != 0)?;
         self.sums.copy_from_slice(&from.sums);
+        self.aovs.copy_from_slice(&from.aovs);
         self.cursor = from.cursor;
         self.tally = Tally::default();
         Ok(())

@@ -204,6 +204,20 @@ pub fn sample_lobes(
     lobes_sample(m, color, s, wo, wi)
 }
 
+/// The albedo a denoiser reads (in [0, 1] for colours in [0, 1]): the lobes' weighted
+/// colours, a conductor's reflectance at normal incidence, Schlick's F0 otherwise. Twin of
+/// WGSL `lobes_albedo`.
+#[inline(always)]
+pub fn lobes_albedo(m: &LobesParams, color: Vec3A) -> Vec3A {
+    let w = lobe_weights(m);
+    let specular = if m.conductor {
+        fresnel_conductor(1.0, m.eta, m.k)
+    } else {
+        Vec3A::ONE.lerp(color, m.specular_tint)
+    };
+    w.x * color + w.y * specular + w.z * Vec3A::ONE.lerp(color, m.refract_tint)
+}
+
 /// Whether the material has a non-delta lobe (next-event estimation is worth doing).
 /// Twin of WGSL `has_continuous_lobes`.
 #[inline(always)]

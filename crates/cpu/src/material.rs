@@ -8,9 +8,9 @@ use pathlight_core::gpu_types::{GpuMaterial, TEXTURE_BASE, TEXTURE_EMISSION};
 use pathlight_core::materials::MODEL_METAL_ROUGH;
 
 use crate::cpu_scene::CpuScene;
-use crate::lobes::{LobesParams, eval_lobes, has_continuous_lobes, sample_lobes};
+use crate::lobes::{LobesParams, eval_lobes, has_continuous_lobes, lobes_albedo, sample_lobes};
 use crate::metal_rough::{
-    MetalRoughParams, has_continuous_metal_rough, metal_rough_textured, sample,
+    MetalRoughParams, has_continuous_metal_rough, metal_rough_albedo, metal_rough_textured, sample,
 };
 use crate::microfacet::{BsdfEval, BsdfSample};
 use crate::surface::Surface;
@@ -127,6 +127,17 @@ pub fn sample_material(
             u_fresnel,
             u,
         ),
+    }
+}
+
+/// The material's albedo for a denoiser's auxiliary image (the approximate colour of the
+/// surface, independent of light and view; in [0, 1] for colours in [0, 1]). Twin of WGSL
+/// `material_albedo`.
+#[inline(always)]
+pub fn material_albedo(p: &MaterialPoint) -> Vec3A {
+    match p.model {
+        MODEL_METAL_ROUGH => metal_rough_albedo(&MetalRoughParams::decode(&p.params), p.base_color),
+        _ => lobes_albedo(&LobesParams::decode(&p.params), p.base_color),
     }
 }
 

@@ -305,6 +305,15 @@ pub fn sample(
     mixture_sample(m, color, s, wo, wi)
 }
 
+/// The albedo a denoiser reads: the specular F0, the diffuse base's colour under what the
+/// specular layer lets through at normal incidence, and the tinted wall. Twin of WGSL
+/// `metal_rough_albedo`.
+#[inline(always)]
+pub fn metal_rough_albedo(m: &MetalRoughParams, color: Vec3A) -> Vec3A {
+    let l = lobes(m, color);
+    l.spec_f0 + (l.diffuse * (1.0 - l.f0_d)) * color + l.wall * color
+}
+
 /// Whether the model has a non-delta lobe. Twin of WGSL `has_continuous_metal_rough`.
 #[inline(always)]
 pub fn has_continuous_metal_rough(m: &MetalRoughParams, color: Vec3A) -> bool {

@@ -4,13 +4,20 @@
 use std::ops::Range;
 
 use glam::Vec3A;
-use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams};
+use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams};
 
 use crate::cpu_scene::CpuScene;
-use crate::integrator::{Path, T_MAX, accumulated_value, add_sample};
+use crate::integrator::{Path, T_MAX, accumulated_value, add_aov_sample, add_sample};
 use crate::packet::{PACKET, RayPacket};
 use crate::sampler::Sampler;
 use crate::tracer::Tracer;
+
+/// A row's running sums: the colour's, and the auxiliary images' (empty when the render has
+/// none).
+pub(crate) struct RowSums<'a> {
+    pub color: &'a mut [GpuAccumPixel],
+    pub aovs: &'a mut [GpuAovPixel],
+}
 
 /// One row's share of an `advance`.
 pub(crate) struct RowJob<'a> {
@@ -52,10 +59,10 @@ impl std::iter::Sum for Tally {
 /// sample. The whole path tracer is inlined here, so that each [`InstructionSet`] level
 /// compiles all of it.
 #[inline(always)]
-fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [GpuAccumPixel]) -> Tally {
+fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
     let (scene, params) = (job.scene, job.params);
     let samples_per_pixel = job.samples.len();
-    let sample_count = row.len() * samples_per_pixel;
+    let sample_count = row.color.len() * samples_per_pixel;
     let mut next_sample = 0;
     let mut lanes: [Option<(usize, Path)>; PACKET] = std::array::from_fn(|_| None);
     let mut tally = Tally::default();
@@ -78,7 +85,7 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [GpuAccumPixel]) -> T
                 if path.alive {
                     *lane = Some((x, path));
                 } else {
-                    tally = tally + finish(&path, &mut row[x]);
+                    tally = tally + finish(&path, row, x);
                 }
             }
             if let Some((_, path)) = lane {
@@ -109,18 +116,21 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut [GpuAccumPixel]) -> T
                 path.add_unblocked(unblocked[l]);
             }
             if !path.alive {
-                tally = tally + finish(path, &mut row[*x]);
+                tally = tally + finish(path, row, *x);
                 *lane = None;
             }
         }
     }
 }
 
-/// Adds the sample of the ended `path` to its pixel's `sum` (a non-finite one as zero);
-/// returns its rays and whether it was dropped.
+/// Adds the sample of the ended `path` to the sums of pixel `x` of `row` (a non-finite
+/// radiance as zero); returns its rays and whether it was dropped.
 #[inline(always)]
-fn finish(path: &Path, sum: &mut GpuAccumPixel) -> Tally {
-    add_sample(sum, accumulated_value(path.sample.radiance));
+fn finish(path: &Path, row: &mut RowSums, x: usize) -> Tally {
+    add_sample(&mut row.color[x], accumulated_value(path.sample.radiance));
+    if let Some(aov) = row.aovs.get_mut(x) {
+        add_aov_sample(aov, &path.sample);
+    }
     Tally {
         rays: u64::from(path.sample.rays),
         dropped: u64::from(!path.sample.radiance.is_finite()),
@@ -190,7 +200,7 @@ pub(crate) fn render_row_with(
     isa: InstructionSet,
     tracer: &mut Tracer,
     job: &RowJob,
-    row: &mut [GpuAccumPixel],
+    row: &mut RowSums,
 ) -> Tally {
     match isa {
         InstructionSet::Baseline => render_row(tracer, job, row),
@@ -206,7 +216,7 @@ pub(crate) fn render_row_with(
 /// [`render_row`] for x86-64-v3.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe")]
-fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut [GpuAccumPixel]) -> Tally {
+fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
     render_row(tracer, job, row)
 }
 
@@ -215,10 +225,6 @@ fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut [GpuAccumPi
 #[target_feature(
     enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe,avx512f,avx512vl,avx512bw,avx512dq,avx512cd,gfni"
 )]
-fn render_row_x86_64_v4_gfni(
-    tracer: &mut Tracer,
-    job: &RowJob,
-    row: &mut [GpuAccumPixel],
-) -> Tally {
+fn render_row_x86_64_v4_gfni(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
     render_row(tracer, job, row)
 }

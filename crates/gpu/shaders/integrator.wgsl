@@ -1,6 +1,7 @@
 // The progressive path-tracing pass. One invocation per pixel of a band of rows adds
 // `batch_samples` jittered (box-filtered) samples to an exact fixed-point accumulation
-// buffer. Paths are unidirectional: next-event estimation and BSDF sampling combined with
+// buffer, and with `params.aovs` the same samples' auxiliary images (albedo and shading
+// normal of the first surface that is not a perfect mirror or glass) to a second one. Paths are unidirectional: next-event estimation and BSDF sampling combined with
 // the power heuristic, `max_depth` counted in segments as Mitsuba counts it, Russian
 // roulette from `rr_depth` on the throughput without the 1/eta^2 radiance scaling (as
 // Mitsuba). Non-finite samples are dropped (counted as zero), so no NaN or Inf reaches
@@ -50,6 +51,13 @@ fn add_fixed(acc: ptr<function, AccumPixel>, x: AccumPixel) {
     (*acc).lo = select(lo, vec4u(0xffffffffu), overflow);
 }
 
+// The auxiliary images of one pixel: per channel a fixed-point sum, the normal stored as
+// (n + 1) / 2. Host: `GpuAovPixel`.
+struct AovPixel {
+    albedo: AccumPixel,
+    normal: AccumPixel,
+}
+
 @group(1) @binding(1) var<storage, read_write> accum: array<AccumPixel>;
 // Since the counters were cleared: rays traced, as a 64-bit count [low word, high word], and
 // samples dropped because their radiance was not finite (none in a correct render).
@@ -62,6 +70,8 @@ var<private> samples_dropped: u32;
 // Rays this workgroup traced and samples it dropped, added to `counters` once per workgroup.
 var<workgroup> workgroup_rays: atomic<u32>;
 var<workgroup> workgroup_dropped: atomic<u32>;
+// With `params.aovs`: one pixel per pixel of `accum` (else a placeholder).
+@group(1) @binding(3) var<storage, read_write> aov: array<AovPixel>;
 
 const T_MAX: f32 = 1.0e30;
 
@@ -90,13 +100,29 @@ fn shadow_ray(p: vec3f, ng: vec3f, ls: LightSample) -> ShadowRay {
     return ShadowRay(Ray(origin, to_light / distance), distance * (1.0 - 1e-4));
 }
 
+// What a path brings back: its radiance and, with `params.aovs`, the albedo and shading
+// normal of the first surface it met that is not a perfect mirror or glass (through those,
+// weighted by what they pass on; the normal zero where it escaped at once).
+// CPU twin: `PathSample`.
+struct PathResult {
+    radiance: vec3f,
+    albedo: vec3f,
+    normal: vec3f,
+}
+
 // One path. Extension and shadow rays go through a single `trace_scene` call site (a shadow
 // ray is traced before the next extension ray), which keeps the kernel half as large as two
 // inlined traversals; the estimator and the order of every sum are those of the CPU twin.
 // CPU twin: `trace_path`.
-fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
+fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> PathResult {
     var ray = first;
     var radiance = vec3f(0.0);
+    // The auxiliary images: still looking for their surface, the weight of the perfect
+    // mirrors and glass passed through so far, what was found.
+    var aov_pending = params.aovs != 0u;
+    var aov_weight = vec3f(1.0);
+    var albedo = vec3f(0.0);
+    var normal = vec3f(0.0);
     var throughput = vec3f(1.0);
     // The BSDF sample that produced `ray`: its density and whether it was a delta lobe
     // (camera rays count as delta: emitters they see get full weight).
@@ -137,7 +163,12 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
             if !prev_delta {
                 w = power_heuristic(prev_pdf, env_pdf(prev_normal, ray.dir));
             }
-            radiance += throughput * env_radiance(ray.dir) * w;
+            let env = env_radiance(ray.dir);
+            radiance += throughput * env * w;
+            if aov_pending {
+                albedo = aov_weight * saturate(env);
+                aov_pending = false;
+            }
             break;
         }
         let s = surface_at(hit, ray);
@@ -150,6 +181,14 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
             }
             radiance += throughput * material.emission * w;
         }
+        let continuous = has_continuous_material_lobe(material);
+        if aov_pending {
+            normal = select(-s.ns, s.ns, dot(wo, s.ng) >= 0.0);
+            if continuous {
+                albedo = aov_weight * saturate(material_albedo(material));
+                aov_pending = false;
+            }
+        }
         if depth == params.max_depth {
             break;
         }
@@ -161,7 +200,7 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
         let u_bsdf = next_2d(sampler);
         let u_rr = next_1d(sampler);
         let n = select(-s.ns, s.ns, dot(wo, s.ng) >= 0.0);
-        if has_continuous_material_lobe(material) {
+        if continuous {
             let ls = sample_light(s.position, n, u_light_select, u_light);
             if ls.valid {
                 let e = eval_material(material, s, wo, ls.wi);
@@ -173,6 +212,11 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
             }
         }
         let bs = sample_material(material, s, wo, u_lobe, u_fresnel, u_bsdf);
+        if aov_pending && bs.valid {
+            // A perfect mirror or glass passes on what it reflects or transmits (without
+            // refraction's radiance scaling).
+            aov_weight *= saturate(bs.weight * bs.eta * bs.eta);
+        }
         if bs.valid {
             throughput *= bs.weight;
             prev_pdf = bs.pdf;
@@ -196,7 +240,23 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> vec3f {
             break;
         }
     }
-    return radiance;
+    if aov_pending {
+        // The path ended on mirrors or glass: they count as white.
+        albedo = aov_weight;
+    }
+    return PathResult(radiance, albedo, normal);
+}
+
+// `acc += ` the auxiliary images of `path`: the albedo, and the normal as (n + 1) / 2
+// (an albedo that is not finite counts as zero, such a normal as the zero vector).
+// CPU twin: `add_aov_sample`
+fn add_aov_sample(acc: ptr<function, AovPixel>, path: PathResult) {
+    // Through locals: naga's SPIR-V writer fails on a pointer to a member of a pointee.
+    var albedo = (*acc).albedo;
+    add_sample(&albedo, select(vec3f(0.0), path.albedo, is_finite3(path.albedo)));
+    var normal = (*acc).normal;
+    add_sample(&normal, select(vec3f(0.5), (path.normal + 1.0) * 0.5, is_finite3(path.normal)));
+    *acc = AovPixel(albedo, normal);
 }
 
 fn is_finite3(v: vec3f) -> bool {
@@ -211,18 +271,29 @@ fn render(@builtin(global_invocation_id) gid: vec3u, @builtin(local_invocation_i
     if x < params.width && y < params.row_end {
         let pixel = y * params.width + x;
         var batch = AccumPixel(vec4u(0u), vec4u(0u));
+        var aov_batch = AovPixel(batch, batch);
         for (var i = 0u; i < params.batch_samples; i++) {
             var sampler = sampler_init(params.sampler, pixel, params.sample_offset + i, params.seed);
-            let radiance = trace_path(camera_ray(x, y, &sampler), &sampler);
-            if is_finite3(radiance) {
-                add_sample(&batch, radiance);
+            let path = trace_path(camera_ray(x, y, &sampler), &sampler);
+            if is_finite3(path.radiance) {
+                add_sample(&batch, path.radiance);
             } else {
                 samples_dropped++;
+            }
+            if params.aovs != 0u {
+                add_aov_sample(&aov_batch, path);
             }
         }
         var total = accum[pixel];
         add_fixed(&total, batch);
         accum[pixel] = total;
+        if params.aovs != 0u {
+            var albedo = aov[pixel].albedo;
+            add_fixed(&albedo, aov_batch.albedo);
+            var normal = aov[pixel].normal;
+            add_fixed(&normal, aov_batch.normal);
+            aov[pixel] = AovPixel(albedo, normal);
+        }
     }
     atomicAdd(&workgroup_rays, rays_traced);
     atomicAdd(&workgroup_dropped, samples_dropped);

@@ -140,6 +140,18 @@ fn sample_lobes(m: LobesParams, color: vec3f, s: Surface, wo: vec3f, u_lobe: f32
     return lobes_sample(m, color, s, wo, wi);
 }
 
+// The albedo a denoiser reads (in [0, 1] for colours in [0, 1]): the lobes' weighted colours,
+// a conductor's reflectance at normal incidence, Schlick's F0 otherwise.
+// CPU twin: `lobes_albedo`.
+fn lobes_albedo(m: LobesParams, color: vec3f) -> vec3f {
+    let w = lobe_weights(m);
+    var specular = mix(vec3f(1.0), color, m.specular_tint);
+    if m.conductor {
+        specular = fresnel_conductor(1.0, m.eta, m.k);
+    }
+    return w.x * color + w.y * specular + w.z * mix(vec3f(1.0), color, m.refract_tint);
+}
+
 // Whether a lobe is not a delta lobe (next-event estimation is worth doing).
 // CPU twin: `has_continuous_lobes`.
 fn has_continuous_lobes(m: LobesParams) -> bool {

@@ -84,6 +84,20 @@ fn sample_material(p: MaterialPoint, s: Surface, wo: vec3f, u_lobe: f32, u_fresn
     }
 }
 
+// The material's albedo for a denoiser's auxiliary image (the approximate colour of the
+// surface, independent of light and view; in [0, 1] for colours in [0, 1]).
+// CPU twin: `material_albedo`.
+fn material_albedo(p: MaterialPoint) -> vec3f {
+    switch p.model {
+        case MODEL_METAL_ROUGH: {
+            return metal_rough_albedo(metal_rough_params(p.params), p.base_color);
+        }
+        default: {
+            return lobes_albedo(lobes_params(p.params), p.base_color);
+        }
+    }
+}
+
 // Whether the BSDF has a non-delta lobe (next-event estimation is worth doing).
 // CPU twin: `has_continuous_material_lobe`.
 fn has_continuous_material_lobe(p: MaterialPoint) -> bool {

@@ -214,6 +214,14 @@ fn sample_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, 
     return mr_mixture_sample(m, color, s, wo, wi);
 }
 
+// The albedo a denoiser reads: the specular F0, the diffuse base's colour under what the
+// specular layer lets through at normal incidence, and the tinted wall.
+// CPU twin: `metal_rough_albedo`.
+fn metal_rough_albedo(m: MetalRoughParams, color: vec3f) -> vec3f {
+    let l = mr_lobes(m, color);
+    return l.spec_f0 + (l.diffuse * (1.0 - l.f0_d)) * color + l.wall * color;
+}
+
 // Whether the model has a non-delta lobe.
 // CPU twin: `has_continuous_metal_rough`.
 fn has_continuous_metal_rough(m: MetalRoughParams, color: vec3f) -> bool {

@@ -47,7 +47,8 @@ struct RenderParams {
     env_width: u32,
     env_height: u32,
     env_scale: f32,
-    pad0: u32,
+    // 1: also accumulate the auxiliary images (`aov` in integrator.wgsl).
+    aovs: u32,
     env_rotation: vec2f,
     pad1: vec2u,
 }

@@ -6,7 +6,7 @@
 
 use std::time::{Duration, Instant};
 
-use pathlight_core::gpu_types::{GpuAccumPixel, GpuRenderParams};
+use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams};
 use pathlight_core::{
     Accumulation, Film, PreparedScene, RenderError, Renderer, SampleCursor, Shading,
 };
@@ -75,6 +75,9 @@ pub struct GpuRenderer {
     pipeline: wgpu::ComputePipeline,
     params_buffer: wgpu::Buffer,
     accum_buffer: wgpu::Buffer,
+    /// The auxiliary images' sums ([`GpuAovPixel`] per pixel), or a placeholder for a render
+    /// without them.
+    aov_buffer: wgpu::Buffer,
     /// Since the last restart: rays traced (64-bit: low word, high word) and samples
     /// dropped as not finite (`counters` in `integrator.wgsl`).
     counters: wgpu::Buffer,
@@ -105,6 +108,7 @@ impl GpuRenderer {
         let device = &ctx.device;
         let params = GpuRenderParams::new(camera, settings, &scene.shading);
         let accum_size = accumulation_size(device, &params)?;
+        let aov_size = aov_size(device, &params)?;
         let scene_buffers = SceneBuffers::upload(device, scene)?;
         let frame_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("frame layout"),
@@ -112,6 +116,7 @@ impl GpuRenderer {
                 storage_entry(0, true),
                 storage_entry(1, false),
                 storage_entry(2, false),
+                storage_entry(3, false),
             ],
         });
         let stack_size = scene
@@ -132,7 +137,8 @@ impl GpuRenderer {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let accum_buffer = create_accumulation(device, accum_size);
+        let accum_buffer = create_accumulation(device, "accumulation", accum_size);
+        let aov_buffer = create_accumulation(device, "auxiliary images", aov_size);
         let counters = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("counters"),
             size: 3 * size_of::<u32>() as u64,
@@ -147,6 +153,7 @@ impl GpuRenderer {
             &params_buffer,
             &accum_buffer,
             &counters,
+            &aov_buffer,
         );
         Ok(Self {
             ctx: ctx.clone(),
@@ -154,6 +161,7 @@ impl GpuRenderer {
             pipeline,
             params_buffer,
             accum_buffer,
+            aov_buffer,
             counters,
             frame_layout,
             frame_bind_group,
@@ -295,14 +303,17 @@ impl Renderer for GpuRenderer {
         self.params.set_camera(camera);
         if (camera.width, camera.height) != old {
             let device = &self.ctx.device;
-            self.accum_buffer =
-                create_accumulation(device, accumulation_size(device, &self.params)?);
+            let size = accumulation_size(device, &self.params)?;
+            self.accum_buffer = create_accumulation(device, "accumulation", size);
+            let size = aov_size(device, &self.params)?;
+            self.aov_buffer = create_accumulation(device, "auxiliary images", size);
             self.frame_bind_group = frame_bind_group(
                 device,
                 &self.frame_layout,
                 &self.params_buffer,
                 &self.accum_buffer,
                 &self.counters,
+                &self.aov_buffer,
             );
             self.rows_per_dispatch = camera.height.min(WORKGROUP * 4);
             self.batch_samples = 1;
@@ -322,6 +333,7 @@ impl Renderer for GpuRenderer {
     fn restart(&mut self) {
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         encoder.clear_buffer(&self.accum_buffer, 0, None);
+        encoder.clear_buffer(&self.aov_buffer, 0, None);
         encoder.clear_buffer(&self.counters, 0, None);
         self.ctx.queue.submit([encoder.finish()]);
         self.cursor = SampleCursor::default();
@@ -388,18 +400,29 @@ impl Renderer for GpuRenderer {
     }
 
     fn accumulation(&self) -> Result<Accumulation, RenderError> {
+        let aovs = if self.params.aovs != 0 {
+            self.read_buffer(&self.aov_buffer)?
+        } else {
+            Vec::new()
+        };
         Ok(Accumulation {
             cursor: self.cursor,
             sums: self.read_buffer(&self.accum_buffer)?,
+            aovs,
         })
     }
 
     fn resume(&mut self, from: &Accumulation) -> Result<(), RenderError> {
-        from.check_fits(self.params.width, self.params.height)?;
+        from.check_fits(self.params.width, self.params.height, self.params.aovs != 0)?;
         self.restart();
         self.ctx
             .queue
             .write_buffer(&self.accum_buffer, 0, bytemuck::cast_slice(&from.sums));
+        if from.has_aovs() {
+            self.ctx
+                .queue
+                .write_buffer(&self.aov_buffer, 0, bytemuck::cast_slice(&from.aovs));
+        }
         self.cursor = from.cursor;
         Ok(())
     }
@@ -432,12 +455,42 @@ impl Renderer for GpuRenderer {
 
 /// Bytes of the accumulation buffer for `params`' image, or why the device cannot bind it.
 fn accumulation_size(device: &wgpu::Device, params: &GpuRenderParams) -> Result<u64, RenderError> {
+    per_pixel_size(
+        device,
+        params,
+        size_of::<GpuAccumPixel>(),
+        "accumulation buffer",
+    )
+}
+
+/// Bytes of the auxiliary images' buffer for `params`' image (a placeholder's without
+/// them), or why the device cannot bind it.
+fn aov_size(device: &wgpu::Device, params: &GpuRenderParams) -> Result<u64, RenderError> {
+    if params.aovs == 0 {
+        return Ok(size_of::<GpuAovPixel>() as u64);
+    }
+    per_pixel_size(
+        device,
+        params,
+        size_of::<GpuAovPixel>(),
+        "buffer of auxiliary images",
+    )
+}
+
+/// Bytes of a buffer of `bytes` per pixel of `params`' image, or why the device cannot bind
+/// it (`what` names it).
+fn per_pixel_size(
+    device: &wgpu::Device,
+    params: &GpuRenderParams,
+    bytes: usize,
+    what: &str,
+) -> Result<u64, RenderError> {
     let pixels = u64::from(params.width) * u64::from(params.height);
-    let size = pixels * size_of::<GpuAccumPixel>() as u64;
+    let size = pixels * bytes as u64;
     let limit = device.limits().max_storage_buffer_binding_size;
     if size > limit {
         return Err(RenderError::Limits(format!(
-            "a {}x{} image needs a {} MiB accumulation buffer; this device binds at most {} MiB",
+            "a {}x{} image needs a {} MiB {what}; this device binds at most {} MiB",
             params.width,
             params.height,
             size >> 20,
@@ -447,10 +500,10 @@ fn accumulation_size(device: &wgpu::Device, params: &GpuRenderParams) -> Result<
     Ok(size)
 }
 
-/// An empty accumulation buffer of `size` bytes.
-fn create_accumulation(device: &wgpu::Device, size: u64) -> wgpu::Buffer {
+/// An empty buffer of sums of `size` bytes, labelled `label`.
+fn create_accumulation(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("accumulation"),
+        label: Some(label),
         size,
         usage: wgpu::BufferUsages::STORAGE
             | wgpu::BufferUsages::COPY_SRC
@@ -459,15 +512,16 @@ fn create_accumulation(device: &wgpu::Device, size: u64) -> wgpu::Buffer {
     })
 }
 
-/// Bind group 1 of the integrator: parameters, accumulation, ray counter.
+/// Bind group 1 of the integrator: parameters, accumulation, ray counter, auxiliary images.
 fn frame_bind_group(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     params: &wgpu::Buffer,
     accum: &wgpu::Buffer,
     counters: &wgpu::Buffer,
+    aovs: &wgpu::Buffer,
 ) -> wgpu::BindGroup {
-    bind_buffers(device, "frame", layout, &[params, accum, counters])
+    bind_buffers(device, "frame", layout, &[params, accum, counters, aovs])
 }
 
 /// The integrator pipeline with the given scheme and traversal stack.

@@ -200,7 +200,7 @@ fn host_structs_match_their_wgsl_declarations() {
             env_width,
             env_height,
             env_scale,
-            pad0,
+            aovs,
             env_rotation,
             pad1
         ]

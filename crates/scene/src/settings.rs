@@ -26,6 +26,10 @@ pub struct RenderSettings {
     pub seed: u32,
     /// The sample generator.
     pub sampler: Sampler,
+    /// Whether the render also accumulates the auxiliary images a denoiser reads (the
+    /// first non-specular hit's albedo and shading normal). A choice of the command, not of
+    /// the scene file: false after loading.
+    pub aovs: bool,
 }
 
 /// The sample generator of a render.

@@ -30,6 +30,7 @@ pub fn scene_of(objects: Vec<Object>) -> Scene {
             rr_depth: 5,
             seed: 0,
             sampler: Sampler::Sobol,
+            aovs: false,
         },
         environment: Environment::default(),
         materials: vec![Material::new(

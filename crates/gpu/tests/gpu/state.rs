@@ -1,17 +1,26 @@
 //! On the GPU, as on the CPU (`crates/app/tests/state.rs`): a render resumed from its own
 //! accumulation, mid-pass included, and any split into sample ranges summed back, equal the
-//! uninterrupted render bit for bit.
+//! uninterrupted render bit for bit, its auxiliary images included.
 
 use pathlight_core::state::{Fingerprint, RenderState, merge};
-use pathlight_core::{Accumulation, PreparedScene, Renderer};
+use pathlight_core::{Accumulation, Film, PreparedScene, Renderer};
 
 use crate::common::{gpu_renderer, render_to, scene};
 
 #[test]
 fn resumed_and_split_renders_equal_the_whole_one() {
-    let scene = scene("refs/cornell-spheres.toml", 16, 7, 3);
+    let mut scene = scene("refs/cornell-spheres.toml", 16, 7, 3);
+    scene.settings.aovs = true;
     let (width, height) = (16, 16);
-    let whole = render_to(&mut gpu_renderer(&scene), 7);
+    let aovs = |renderer: &dyn Renderer| {
+        Film::aovs_from_accumulation(width, height, &renderer.accumulation().unwrap())
+            .expect("the render has auxiliary images")
+    };
+    let mut whole_renderer = gpu_renderer(&scene);
+    let whole = render_to(&mut whole_renderer, 7);
+    let whole_aovs = aovs(&whole_renderer);
+    // The glass sphere's albedo is what it lets through and reflects: not white, not black.
+    assert!(whole_aovs.0.mean().iter().all(|&c| c > 0.05 && c < 0.95));
 
     // Stopped mid-pass (rows 0..8 one sample ahead), resumed in another renderer.
     let mut first = gpu_renderer(&scene);
@@ -23,6 +32,10 @@ fn resumed_and_split_renders_equal_the_whole_one() {
     let mut resumed = gpu_renderer(&scene);
     resumed.resume(&saved).unwrap();
     assert!(render_to(&mut resumed, 7) == whole, "resumed mid-pass");
+    assert!(
+        aovs(&resumed) == whole_aovs,
+        "resumed mid-pass, auxiliary images"
+    );
 
     // Split into 3 ranges, each from an empty image starting at its first sample.
     let prepared = PreparedScene::new(&scene).unwrap();
@@ -32,7 +45,7 @@ fn resumed_and_split_renders_equal_the_whole_one() {
         .map(|range| {
             let mut renderer = gpu_renderer(&scene);
             renderer
-                .resume(&Accumulation::empty(width, height, range.start))
+                .resume(&Accumulation::empty(width, height, range.start, true))
                 .unwrap();
             render_to(&mut renderer, range.len() as u32);
             let accumulation = renderer.accumulation().unwrap();
@@ -48,4 +61,8 @@ fn resumed_and_split_renders_equal_the_whole_one() {
     let merged = merge(&parts).unwrap();
     assert!(merged.missing.is_empty());
     assert!(merged.film() == whole, "3 ranges merged");
+    assert!(
+        merged.aov_films() == Some(whole_aovs),
+        "3 ranges merged, auxiliary images"
+    );
 }

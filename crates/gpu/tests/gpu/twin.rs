@@ -1,8 +1,11 @@
 //! The GPU integrator against its CPU twin: the same samples of the same pixels through the
 //! same code give the same image, up to float differences that may flip a rare discrete
-//! choice (lobe, roulette). Checked on every material and emitter kind.
+//! choice (lobe, roulette). Checked on every material and emitter kind, and on the
+//! auxiliary images.
 
-use crate::common::{render, render_cpu, scene};
+use pathlight_core::{Film, PreparedScene, Renderer};
+
+use crate::common::{gpu_renderer, render, render_cpu, render_to, scene};
 
 #[test]
 fn gpu_and_cpu_render_the_same_image() {
@@ -39,6 +42,39 @@ fn gpu_and_cpu_render_the_same_image() {
             assert!(
                 (g[i] - c[i]).abs() <= 0.01 * c[i],
                 "{name}: GPU mean {g:?}, CPU mean {c:?}"
+            );
+        }
+    }
+}
+
+/// With auxiliary images the colour is the same bit for bit, and the auxiliary images of the
+/// two backends agree as the colour does (the albedo and normal of the same first surfaces).
+#[test]
+fn gpu_and_cpu_render_the_same_auxiliary_images() {
+    for name in ["default.toml", "refs/cornell-materials.toml"] {
+        let plain = scene(name, 32, 2, 5);
+        let mut s = plain.clone();
+        s.settings.aovs = true;
+        let mut gpu = gpu_renderer(&s);
+        let colour = render_to(&mut gpu, 2);
+        assert!(colour == render(&plain), "{name}: the colour changed");
+        let gpu = Film::aovs_from_accumulation(32, 32, &gpu.accumulation().unwrap()).unwrap();
+        let prepared = PreparedScene::new(&s).unwrap();
+        let mut cpu = pathlight_cpu::CpuRenderer::new(&prepared, &s.camera, &s.settings);
+        render_to(&mut cpu, 2);
+        let cpu = Film::aovs_from_accumulation(32, 32, &cpu.accumulation().unwrap()).unwrap();
+        for (what, g, c) in [("albedo", &gpu.0, &cpu.0), ("normal", &gpu.1, &cpu.1)] {
+            let close = g
+                .pixels
+                .iter()
+                .zip(&c.pixels)
+                .filter(|(g, c)| (0..3).all(|i| (g[i] - c[i]).abs() <= 1e-3))
+                .count();
+            println!("{name}, {what}: {close} of {} pixels agree", g.pixels.len());
+            assert!(
+                close * 100 >= 99 * g.pixels.len(),
+                "{name}, {what}: only {close} of {} pixels agree",
+                g.pixels.len()
             );
         }
     }

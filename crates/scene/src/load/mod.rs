@@ -300,6 +300,7 @@ impl From<&RenderDesc> for RenderSettings {
                 SamplerDesc::Sobol => Sampler::Sobol,
                 SamplerDesc::Independent => Sampler::Independent,
             },
+            aovs: false,
         }
     }
 }
