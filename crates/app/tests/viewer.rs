@@ -373,6 +373,49 @@ fn iterates_waits_for_right_clicks_picks_saves_and_drags(backend: &str) {
             .ends_with(&format!(" {depth}"))
     );
 
+    // `D` shows the denoised image (the accumulation paused, so that only the view
+    // changes), and again the raw one.
+    x.run("xdotool", &["key", "space"]);
+    viewer.wait_for("paused", 1);
+    std::thread::sleep(Duration::from_millis(300));
+    let raw = screenshot(&x, &window, dir.path(), "raw.png");
+    x.run("xdotool", &["key", "d"]);
+    assert_eq!(viewer.wait_for("denoised view", 1), "denoised view on");
+    viewer.wait_for("denoising done:", 1);
+    std::thread::sleep(Duration::from_millis(300));
+    let title = x.run("xdotool", &["getwindowname", &window]);
+    assert!(title.contains("| denoised"), "{title}");
+    let denoised = screenshot(&x, &window, dir.path(), "denoised.png");
+    x.run("xdotool", &["key", "d"]);
+    assert_eq!(viewer.wait_for("denoised view", 2), "denoised view off");
+    std::thread::sleep(Duration::from_millis(300));
+    let raw_again = screenshot(&x, &window, dir.path(), "raw-again.png");
+    let difference = |a: &Path, b: &Path| {
+        let (a, b) = (
+            image::open(a).unwrap().to_rgb8(),
+            image::open(b).unwrap().to_rgb8(),
+        );
+        let sum: u64 = a
+            .pixels()
+            .zip(b.pixels())
+            .flat_map(|(p, q)| {
+                p.0.into_iter()
+                    .zip(q.0)
+                    .map(|(x, y)| u64::from(x.abs_diff(y)))
+            })
+            .sum();
+        sum as f64 / (3 * a.width() * a.height()) as f64
+    };
+    let (changed, restored) = (difference(&raw, &denoised), difference(&raw, &raw_again));
+    println!(
+        "{backend}: denoised differs from raw by {changed:.2} levels, raw again by {restored:.2}"
+    );
+    assert!(
+        changed > 1.0 && restored < 0.1,
+        "denoised differs from raw by {changed:.2} levels, raw again by {restored:.2}"
+    );
+    x.run("xdotool", &["key", "space"]);
+
     // `Esc` quits cleanly.
     x.run("xdotool", &["key", "Escape"]);
     let started = Instant::now();

@@ -174,6 +174,12 @@ impl CpuRenderer {
         &self.sums
     }
 
+    /// The auxiliary images' sums, one per pixel, row by row (empty for a render without
+    /// them), holding the samples [`Self::cursor`] says.
+    pub fn aov_sums(&self) -> &[GpuAovPixel] {
+        &self.aovs
+    }
+
     /// The samples the sums hold.
     pub fn cursor(&self) -> SampleCursor {
         self.cursor

@@ -10,7 +10,8 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use anyhow::anyhow;
-use pathlight_core::gpu_types::GpuAccumPixel;
+use pathlight_core::Accumulation;
+use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel};
 use pathlight_core::{Film, RenderError, Renderer, SampleCursor, Shading};
 use pathlight_cpu::CpuRenderer;
 use pathlight_cpu::display::{CpuDisplay, DisplayImage};
@@ -36,6 +37,8 @@ struct Image {
     rays: u64,
     /// Fixed-point sums, row by row.
     pixels: Vec<GpuAccumPixel>,
+    /// The auxiliary images' sums, row by row (empty without them).
+    aovs: Vec<GpuAovPixel>,
 }
 
 impl Image {
@@ -248,21 +251,7 @@ impl Frames for CpuFrames {
             &mut self.bytes,
         );
         drop(state);
-        let (width, height) = target.size;
-        target.ctx.queue.write_texture(
-            target.texture.as_image_copy(),
-            &self.bytes,
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(4 * width),
-                rows_per_image: None,
-            },
-            wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-        );
+        target.copy_pixels(&self.bytes);
     }
 
     fn film(&self) -> anyhow::Result<Film> {
@@ -274,6 +263,16 @@ impl Frames for CpuFrames {
             &image.cursor,
             &image.pixels,
         ))
+    }
+
+    fn accumulation(&self) -> anyhow::Result<Accumulation> {
+        let state = self.shared.lock();
+        let image = &state.image;
+        Ok(Accumulation {
+            cursor: image.cursor,
+            sums: image.pixels.clone(),
+            aovs: image.aovs.clone(),
+        })
     }
 
     fn samples_done(&self) -> u32 {
@@ -373,13 +372,18 @@ fn render_loop(mut renderer: CpuRenderer, shared: &Shared, notify: impl Fn()) {
 /// of it when `image` held another restart than `epoch`.
 fn publish(renderer: &CpuRenderer, epoch: u64, rows: Range<u32>, image: &mut Image) {
     let (width, height) = renderer.size();
-    let sums = renderer.sums();
+    let (sums, aovs) = (renderer.sums(), renderer.aov_sums());
     if image.epoch != epoch || (image.width, image.height) != (width, height) {
         image.pixels.clear();
         image.pixels.extend_from_slice(sums);
+        image.aovs.clear();
+        image.aovs.extend_from_slice(aovs);
     } else {
         let pixels = (rows.start * width) as usize..(rows.end * width) as usize;
-        image.pixels[pixels.clone()].copy_from_slice(&sums[pixels]);
+        image.pixels[pixels.clone()].copy_from_slice(&sums[pixels.clone()]);
+        if !aovs.is_empty() {
+            image.aovs[pixels.clone()].copy_from_slice(&aovs[pixels]);
+        }
     }
     image.epoch = epoch;
     (image.width, image.height) = (width, height);

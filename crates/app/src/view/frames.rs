@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-use pathlight_core::{Film, Renderer, Shading, ToneMap};
+use pathlight_core::{Accumulation, Film, Renderer, Shading, ToneMap};
 use pathlight_cpu::display::ChannelOrder;
 use pathlight_gpu::display::{DisplayPass, DisplaySource};
 use pathlight_gpu::{GpuContext, GpuRenderer};
@@ -42,6 +42,26 @@ impl Target<'_> {
         self.display
             .draw(self.ctx, source, &view, self.size, self.tonemap);
     }
+
+    /// Copies `bytes`, 8-bit pixels of the target's size in its byte order (`direct`), into
+    /// the surface texture.
+    pub fn copy_pixels(&self, bytes: &[u8]) {
+        let (width, height) = self.size;
+        self.ctx.queue.write_texture(
+            self.texture.as_image_copy(),
+            bytes,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(4 * width),
+                rows_per_image: None,
+            },
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
 }
 
 /// A progressive render the viewer drives and shows.
@@ -70,6 +90,9 @@ pub trait Frames {
 
     /// The image as shown.
     fn film(&self) -> anyhow::Result<Film>;
+
+    /// The sums of the image as shown, its auxiliary images' included.
+    fn accumulation(&self) -> anyhow::Result<Accumulation>;
 
     /// Whole samples per pixel of the image as shown.
     fn samples_done(&self) -> u32;
@@ -149,6 +172,10 @@ impl Frames for GpuFrames {
 
     fn film(&self) -> anyhow::Result<Film> {
         Ok(self.renderer.film()?)
+    }
+
+    fn accumulation(&self) -> anyhow::Result<Accumulation> {
+        Ok(self.renderer.accumulation()?)
     }
 
     fn samples_done(&self) -> u32 {

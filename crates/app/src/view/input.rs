@@ -20,6 +20,8 @@ pub enum Action {
     Restart,
     /// The next tone mapper (`T`).
     CycleTonemap,
+    /// Show the denoised image or the raw one (`D`).
+    ToggleDenoised,
     /// Start the next iteration (right click).
     NextIteration,
     /// Toggle the object under this window point between light and material (left click).
@@ -133,6 +135,7 @@ pub fn key_action(event: &KeyEvent, pointer: PhysicalPosition<f64>) -> Option<Ac
             "s" => Action::Save,
             "r" => Action::Restart,
             "t" => Action::CycleTonemap,
+            "d" => Action::ToggleDenoised,
             "f" => Action::Focus(pointer),
             "]" => Action::Aperture(APERTURE_STEP),
             "[" => Action::Aperture(1.0 / APERTURE_STEP),

@@ -21,6 +21,7 @@ macro_rules! say {
 
 mod camera;
 mod cpu_frames;
+mod denoised;
 mod frames;
 mod input;
 mod iterations;
@@ -45,6 +46,7 @@ use crate::backend::load_scene;
 use crate::cli::{DeviceArgs, ViewArgs};
 use crate::output;
 use camera::{Orbit, next_aperture};
+use denoised::{Denoised, Moment};
 use input::{Action, Pointer, key_action, wheel_action};
 use iterations::{Iterations, Phase};
 use picking::{LightSwitch, Picked, pick};
@@ -118,16 +120,23 @@ struct Viewer {
     save_dir: PathBuf,
     pointer: Pointer,
     rays: RayRate,
+    /// The denoised view (`D`).
+    denoised: Denoised,
+    /// Restarts of the image so far (a denoised image belongs to one).
+    epoch: u64,
     window: Option<ViewerWindow>,
     error: Option<anyhow::Error>,
 }
 
 impl Viewer {
     fn new(
-        scene: Scene,
+        mut scene: Scene,
         args: &ViewArgs,
         proxy: EventLoopProxy<FrameReady>,
     ) -> anyhow::Result<Self> {
+        // With OIDN the renderer also accumulates the albedo and normal that guide it.
+        let denoised = Denoised::new(pathlight_denoise::Denoiser::load());
+        scene.settings.aovs = denoised.available();
         Ok(Self {
             preview: Preview::new(),
             rendering: (scene.camera.width, scene.camera.height),
@@ -143,6 +152,8 @@ impl Viewer {
             save_dir: args.save_dir.clone(),
             pointer: Pointer::default(),
             rays: RayRate::new(),
+            denoised,
+            epoch: 0,
             window: None,
             error: None,
         })
@@ -158,6 +169,7 @@ impl Viewer {
     fn restarted(&mut self) {
         self.iterations.restart();
         self.rays.restart();
+        self.epoch += 1;
         if let Some(window) = &self.window {
             window.window.request_redraw();
         }
@@ -225,12 +237,14 @@ impl Viewer {
         let moving = self.preview.is_moving();
         self.preview
             .timed(rendered.frames, rendered.time, pixels, Instant::now());
+        let mut iteration_ended = false;
         if !moving {
             self.iterations.add_time(rendered.time);
             for _ in 0..rendered.frames {
                 let Some(finished) = self.iterations.frame_done() else {
                     continue;
                 };
+                iteration_ended = true;
                 say!(
                     "iter {} finished, {:.2} fps",
                     finished.iteration,
@@ -244,7 +258,31 @@ impl Viewer {
                 }
             }
         }
-        window.present(self.tonemap);
+        if let Some(line) = self.denoised.collect() {
+            say!("{line}");
+        }
+        let samples = window.frames.samples_done();
+        let moment = match (
+            iteration_ended,
+            self.paused || self.iterations.phase() != Phase::Running,
+        ) {
+            (true, _) => Moment::IterationEnded,
+            (false, true) => Moment::Idle,
+            (false, false) => Moment::Rendering,
+        };
+        if !moving && self.denoised.due(self.epoch, samples, moment) {
+            let proxy = self.proxy.clone();
+            self.denoised.start(
+                window.frames.accumulation()?,
+                self.rendering,
+                self.epoch,
+                move || {
+                    let _ = proxy.send_event(FrameReady);
+                },
+            );
+        }
+        let showing = self.denoised.showing(self.epoch);
+        window.present(self.tonemap, showing.then_some(&mut self.denoised));
         let frames = &window.frames;
         self.rays.update(|| frames.rays_traced())?;
         let title = Title {
@@ -255,6 +293,11 @@ impl Viewer {
             rays: &self.rays,
             device: &frames.device(),
             tonemap: self.tonemap,
+            shown: &match (showing, self.denoised.is_on()) {
+                (true, _) => "denoised".to_string(),
+                (false, true) => "raw (denoising)".to_string(),
+                (false, false) => "raw".to_string(),
+            },
         }
         .to_string();
         window.window.set_title(&title);
@@ -271,6 +314,11 @@ impl Viewer {
             say!("nothing to save yet: no frame finished");
             return Ok(());
         }
+        // What is shown: the denoised image when the view shows one.
+        let (film, what) = match self.denoised.shown_film(self.epoch) {
+            Some(denoised) => (denoised.clone(), ", denoised"),
+            None => (film, ""),
+        };
         let stem = (1..)
             .map(|n| self.save_dir.join(format!("pathlight-view-{n:03}")))
             .find(|stem| {
@@ -281,7 +329,7 @@ impl Viewer {
         output::write(&film, &png)?;
         output::write(&film, &exr)?;
         say!(
-            "saved {} and {} ({} spp)",
+            "saved {} and {} ({} spp{what})",
             png.display(),
             exr.display(),
             film.spp
@@ -361,6 +409,10 @@ impl Viewer {
                 self.tonemap = self.tonemap.next();
                 say!("tone mapping: {}", self.tonemap.name());
             }
+            Action::ToggleDenoised => match self.denoised.toggle() {
+                Ok(on) => say!("denoised view {}", if on { "on" } else { "off" }),
+                Err(why) => say!("no denoised view: {why}"),
+            },
             Action::NextIteration => {
                 if self.iterations.start_next() {
                     let (iteration, iters) = self.iterations.position();

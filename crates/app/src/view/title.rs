@@ -67,6 +67,8 @@ pub struct Title<'a> {
     pub device: &'a str,
     /// The display's tone mapper.
     pub tonemap: ToneMap,
+    /// Which image is shown: `raw`, or the denoised one's samples (`denoised 64 spp`).
+    pub shown: &'a str,
 }
 
 impl std::fmt::Display for Title<'_> {
@@ -87,11 +89,12 @@ impl std::fmt::Display for Title<'_> {
         };
         write!(
             f,
-            "pathlight | {} spp | iter {iteration}/{iters} | {fps} fps | {:.1} M rays/s | {} | {}{state}",
+            "pathlight | {} spp | iter {iteration}/{iters} | {fps} fps | {:.1} M rays/s | {} | {} | {}{state}",
             self.spp,
             self.rays.per_second / 1e6,
             self.device,
             self.tonemap.name(),
+            self.shown,
         )
     }
 }

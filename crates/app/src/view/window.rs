@@ -21,6 +21,7 @@ use crate::backend::explain;
 use crate::cli::{Backend, DeviceArgs};
 use crate::view::FrameReady;
 use crate::view::cpu_frames::CpuFrames;
+use crate::view::denoised::Denoised;
 use crate::view::frames::{Frames, GpuFrames, Target};
 
 /// Aimed-for GPU time of one submission on a GPU, so the window never freezes.
@@ -124,9 +125,9 @@ impl ViewerWindow {
         self.surface.configure(&self.ctx.device, &self.config);
     }
 
-    /// Shows the renderer's current image through `tonemap`. A lost or outdated surface is
-    /// configured again and the window asked to redraw.
-    pub fn present(&mut self, tonemap: ToneMap) {
+    /// Shows the renderer's current image through `tonemap`, or `denoised`'s image in its
+    /// place. A lost or outdated surface is configured again and the window asked to redraw.
+    pub fn present(&mut self, tonemap: ToneMap, denoised: Option<&mut Denoised>) {
         let frame = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(frame)
             | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => frame,
@@ -149,7 +150,10 @@ impl ViewerWindow {
             direct: self.direct,
             tonemap,
         };
-        self.frames.draw(&target);
+        match denoised {
+            Some(denoised) => denoised.draw(&target),
+            None => self.frames.draw(&target),
+        }
         self.ctx.queue.present(frame);
     }
 }
