@@ -62,7 +62,7 @@ pub enum DenoiseMode {
     /// prefiltering), then the image with them as clean guides, at high quality.
     Final,
     /// Previews: the image with the albedo and normal as they are, at balanced quality
-    /// (about a third of `final`'s time; what the viewer uses).
+    /// (about a seventh of `final`'s time; what the viewer uses).
     Fast,
 }
 

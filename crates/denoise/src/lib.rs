@@ -53,10 +53,12 @@ pub enum DenoiseError {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {
     /// For final images: the auxiliary images are denoised first (OIDN's prefiltering),
-    /// then the film with them as clean guides, at OIDN's high quality.
+    /// then the film with them as clean guides, every filter at OIDN's high quality (its
+    /// larger network where the guides are clean). About seven times `Fast`'s time; the
+    /// lowest error of the variants measured (BENCHMARKS.md).
     Final,
     /// For previews and the viewer: the film with the auxiliary images as they are, at
-    /// OIDN's balanced quality (about a third of `Final`'s time).
+    /// OIDN's balanced quality.
     Fast,
 }
 
