@@ -1,18 +1,40 @@
 #!/usr/bin/env bash
-# Times pathlight and Mitsuba 3 on the same machine, in one run: cornell-spheres at 512x512,
-# 64 spp, the scene's max_depth. pathlight: whole-process time of `pathlight render` (CPU
-# backend with its default Sobol sampler and with the independent sampler Mitsuba uses here,
-# median of 3 each; and one run of the GPU backend on whatever adapter is found). Mitsuba:
-# render time alone (llvm_ad_rgb, after one untimed render that compiles its kernels),
-# median of 3. Quality: each image's relMSE against the stored converged reference
-# (scenes/refs/images), the same measure as the reference tests.
+# pathlight's CPU backend against Mitsuba 3 (`llvm_ad_rgb`) on the same machine, in one run,
+# on every reference scene of scenes/refs (the furnace rings left out but furnace-0.8): the
+# same resolution and spp, three rounds, pathlight and Mitsuba interleaved in each. pathlight:
+# whole-process time of `pathlight render --backend cpu` (its default Sobol sampler);
+# Mitsuba: render time alone, after one untimed render that compiles its kernels (its
+# independent sampler). Quality: each image's relMSE against the scene's converged reference
+# (scenes/refs/images, the measure of the reference tests). Printed per scene: the median
+# samples/s of each, their ratio, the relMSE of each at equal spp, and the time-to-equal-error
+# ratio, (Mitsuba time x Mitsuba relMSE) / (pathlight time x pathlight relMSE): above 1,
+# pathlight reaches an error first (Monte Carlo error falls as 1/time).
 #
 # Installs what it needs: Debian's libllvm19 and python3-venv (apt-get, as root or with
 # sudo), then Mitsuba and NumPy from pip into a virtual environment (MITSUBA_VENV, default
-# bench/.venv). Usage: bash bench/compare-mitsuba.sh [--skip-gpu]
+# bench/.venv).
+#
+#   bash bench/compare-mitsuba.sh [--res N] [--spp N] [--rounds N] [SCENE...]
+#     defaults: 256x256, 256 spp, 3 rounds, every scene
+#   PATHLIGHT=path/to/binary selects the pathlight binary (default: a fresh release build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-SCENE=cornell-spheres RES=512 SPP=64
+RES=256 SPP=256 ROUNDS=3 SCENES=()
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --res) RES=$2; shift 2 ;;
+        --spp) SPP=$2; shift 2 ;;
+        --rounds) ROUNDS=$2; shift 2 ;;
+        *) SCENES+=("$1"); shift ;;
+    esac
+done
+if [ ${#SCENES[@]} -eq 0 ]; then
+    for f in scenes/refs/*.toml; do
+        name=$(basename "$f" .toml)
+        case "$name" in furnace-*) [ "$name" = furnace-0.8 ] || continue ;; esac
+        SCENES+=("$name")
+    done
+fi
 VENV=${MITSUBA_VENV:-bench/.venv}
 LLVM=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1
 
@@ -26,56 +48,40 @@ if [ ! -x "$VENV/bin/python" ]; then
     "$VENV/bin/pip" install --quiet mitsuba numpy
 fi
 export DRJIT_LIBLLVM_PATH=$LLVM
-
-cargo build --release --locked --quiet
+if [ -z "${PATHLIGHT:-}" ]; then
+    cargo build --release --locked --quiet
+    PATHLIGHT=./target/release/pathlight
+fi
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-echo "load: $(cut -d' ' -f1-3 /proc/loadavg) (a busy machine halves both sides)"
-
-# Whole-process wall time of a pathlight render into $out/$2.exr, in seconds: the median of
-# $1 runs.
-time_pathlight() {
-    local runs=$1 image=$2 start end run times=()
-    shift 2
-    for run in $(seq "$runs"); do
-        start=$(date +%s.%N)
-        ./target/release/pathlight render "scenes/refs/$SCENE.toml" --width $RES --height $RES \
-            --spp $SPP -o "$out/$image.exr" "$@" 2>"$out/log" || { cat "$out/log"; exit 1; }
-        end=$(date +%s.%N)
-        times+=("$(awk "BEGIN { print $end - $start }")")
-    done
-    printf '%s\n' "${times[@]}" | sort -g | sed -n "$(((runs + 1) / 2))p"
-}
-
+isa=$("$PATHLIGHT" render scenes/refs/furnace-0.8.toml --backend cpu --width 8 --height 8 --spp 1 \
+    -o "$out/probe.png" 2>&1 | sed -n 's/.*backend: cpu backend, \(.*\)/\1/p')
+echo "$(date -u +%F), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(nproc) cores, pathlight $isa"
+echo "load: $(cut -d' ' -f1-3 /proc/loadavg) (a busy machine slows both sides)"
+echo "${RES}x${RES}, $SPP spp, $ROUNDS rounds"
 samples=$((RES * RES * SPP))
-cpu_s=$(time_pathlight 3 sobol --backend cpu)
-cpu_ind_s=$(time_pathlight 3 independent --backend cpu --sampler independent)
-if [ "${1:-}" != "--skip-gpu" ]; then
-    gpu_s=$(time_pathlight 1 gpu --backend gpu)
-    adapter=$(grep -o 'adapter: .*' "$out/log" | head -1)
-fi
-mitsuba_json=$("$VENV/bin/python" tools/mitsuba_refs.py time $SCENE --res $RES --spp $SPP \
-    --save "$out/mitsuba.exr")
-mitsuba_s=$(echo "$mitsuba_json" | "$VENV/bin/python" -c 'import json,sys; print(json.load(sys.stdin)["median_seconds"])')
-# Quality: relMSE of each image against the converged reference (its 256x256 box average).
-relmse_json=$("$VENV/bin/python" tools/mitsuba_refs.py relmse-of $SCENE "$out"/*.exr)
-relmse() {
-    echo "$relmse_json" | "$VENV/bin/python" -c '
-import json, sys
-print(next(r["relmse"] for r in map(json.loads, sys.stdin) if r["image"].endswith("/" + sys.argv[1])))' "$1.exr"
-}
 
-row() { # label seconds image
-    printf '%-48s %8.2f %12.2f %10.5f\n' "$1" "$2" "$(awk "BEGIN { print $samples / $2 / 1e6 }")" "$(relmse "$3")"
-}
-max_depth=$(sed -n 's/^max_depth *= *//p' "scenes/refs/$SCENE.toml")
-printf '%-48s %8s %12s %10s\n' "$SCENE ${RES}x${RES}, $SPP spp, max_depth $max_depth" "seconds" "M samples/s" "relMSE"
-row "pathlight --backend cpu, Sobol (process)" "$cpu_s" sobol
-row "pathlight --backend cpu, independent (process)" "$cpu_ind_s" independent
-if [ -n "${gpu_s:-}" ]; then
-    row "pathlight --backend gpu, Sobol (process)" "$gpu_s" gpu
-    echo "    ($adapter)"
-fi
-row "Mitsuba 3 llvm_ad_rgb, independent (render)" "$mitsuba_s" mitsuba
-printf 'pathlight cpu / Mitsuba samples/s: %.2f (Sobol, the default), %.2f (independent, as Mitsuba)\n' \
-    "$(awk "BEGIN { print $mitsuba_s / $cpu_s }")" "$(awk "BEGIN { print $mitsuba_s / $cpu_ind_s }")"
+median() { sort -g | sed -n "$(((ROUNDS + 1) / 2))p"; }
+
+printf '%-26s %12s %12s %7s %10s %10s %8s\n' scene "pathlight" "Mitsuba" ratio "relMSE pl" "relMSE mi" "to-error"
+for scene in "${SCENES[@]}"; do
+    pl_times=() mi_times=()
+    for round in $(seq "$ROUNDS"); do
+        start=$(date +%s.%N)
+        "$PATHLIGHT" render "scenes/refs/$scene.toml" --backend cpu --width "$RES" --height "$RES" \
+            --spp "$SPP" -o "$out/pathlight.exr" 2>"$out/log" || { cat "$out/log"; exit 1; }
+        end=$(date +%s.%N)
+        pl_times+=("$(awk "BEGIN { print $end - $start }")")
+        json=$("$VENV/bin/python" tools/mitsuba_refs.py time "$scene" --res "$RES" --spp "$SPP" \
+            --repeats 1 --save "$out/mitsuba.exr")
+        mi_times+=("$(echo "$json" | "$VENV/bin/python" -c 'import json,sys; print(json.load(sys.stdin)["median_seconds"])')")
+    done
+    pl=$(printf '%s\n' "${pl_times[@]}" | median)
+    mi=$(printf '%s\n' "${mi_times[@]}" | median)
+    errors=$("$VENV/bin/python" tools/mitsuba_refs.py relmse-of "$scene" "$out/pathlight.exr" "$out/mitsuba.exr" |
+        "$VENV/bin/python" -c 'import json,sys; print(" ".join(str(json.loads(l)["relmse"]) for l in sys.stdin))')
+    read -r pl_err mi_err <<<"$errors"
+    awk -v s="$scene" -v n="$samples" -v p="$pl" -v m="$mi" -v pe="$pl_err" -v me="$mi_err" 'BEGIN {
+        printf "%-26s %12.2f %12.2f %7.2f %10.5f %10.5f %8.2f\n", s, n / p / 1e6, n / m / 1e6, m / p, pe, me, (m * me) / (p * pe) }'
+done
+echo "(pathlight and Mitsuba in M samples/s; ratio = pathlight / Mitsuba samples/s; to-error = Mitsuba's time to pathlight's at equal error)"

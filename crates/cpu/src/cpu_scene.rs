@@ -36,6 +36,8 @@ pub struct CpuScene<'a> {
     pub env_texels: &'a [u32],
     /// The environment map's sampling distribution (WGSL `env_distribution`).
     pub env_distribution: &'a [f32],
+    /// Its CDFs' guide tables (the CPU's alone: `EnvironmentData::guides`).
+    pub env_guides: &'a [u16],
     /// Per object: a quad's unit normal and area; zero for other kinds.
     quads: Vec<(Vec3A, f32)>,
 }
@@ -66,6 +68,7 @@ impl<'a> CpuScene<'a> {
             texels: &scene.textures.texels,
             env_texels: &scene.environment.texels,
             env_distribution: &scene.environment.distribution,
+            env_guides: &scene.environment.guides,
             quads,
         }
     }

@@ -8,13 +8,13 @@
 use std::f32::consts::{FRAC_1_PI, PI, TAU};
 
 use glam::{Vec2, Vec3A};
-use pathlight_core::environment::decode_rgb9e5;
+use pathlight_core::environment::{decode_rgb9e5, guide_bucket};
 use pathlight_core::gpu_types::GpuRenderParams;
 
 use crate::cpu_scene::CpuScene;
 use crate::light_sample::LightSample;
 use crate::sampling::sin_cos_turns;
-use crate::sampling::{Frame, sample_cosine_hemisphere};
+use crate::sampling::{Frame, acos, atan2, first_above, sample_cosine_hemisphere};
 
 /// Whether the environment is a map. Twin of WGSL `has_env_map`.
 #[inline(always)]
@@ -36,11 +36,12 @@ fn from_map(params: &GpuRenderParams, d: Vec3A) -> Vec3A {
     Vec3A::new(c * d.x + s * d.z, d.y, -s * d.x + c * d.z)
 }
 
-/// Mitsuba's latitude-longitude coordinates of map-frame `d`. Twin of WGSL `map_uv`.
+/// Mitsuba's latitude-longitude coordinates of map-frame `d` (through [`atan2`] and
+/// [`acos`], polynomials within 5e-7 of libm's, inline). Twin of WGSL `map_uv`.
 #[inline(always)]
 fn map_uv(d: Vec3A) -> Vec2 {
-    let u = d.x.atan2(-d.z) * (1.0 / TAU);
-    Vec2::new(u - u.floor(), d.y.clamp(-1.0, 1.0).acos() * FRAC_1_PI)
+    let u = atan2(d.x, -d.z) * (1.0 / TAU);
+    Vec2::new(u - u.floor(), acos(d.y.clamp(-1.0, 1.0)) * FRAC_1_PI)
 }
 
 /// The cell holding `uv` and the position in it. Twin of WGSL `MapCell`.
@@ -97,19 +98,19 @@ fn cdf_pmf(d: &[f32], start: u32, k: u32) -> f32 {
     }
 }
 
-/// First entry of the `n`-entry CDF at `start` exceeding `u`. Twin of WGSL `cdf_search`.
+/// First entry of the `n`-entry CDF at `start` exceeding `u` (the last when none does),
+/// searched from its guide table at `guide` (`pathlight_core::environment`) between the
+/// entries of `u`'s bucket and the next. Twin of WGSL `cdf_search`, which searches the whole
+/// CDF.
 #[inline(always)]
-fn cdf_search(d: &[f32], start: u32, n: u32, u: f32) -> u32 {
-    let (mut lo, mut hi) = (0, n - 1);
-    while lo < hi {
-        let mid = (lo + hi) / 2;
-        if d[(start + mid) as usize] > u {
-            hi = mid;
-        } else {
-            lo = mid + 1;
-        }
-    }
-    lo
+fn cdf_search(scene: &CpuScene, start: u32, n: u32, guide: u32, u: f32) -> u32 {
+    let cdf = &scene.env_distribution[start as usize..(start + n) as usize];
+    let k = (guide + guide_bucket(u, n)) as usize;
+    let (lo, hi) = (
+        u32::from(scene.env_guides[k]),
+        u32::from(scene.env_guides[k + 1]),
+    );
+    lo + first_above(hi - lo + 1, u, |i| cdf[(lo + i) as usize])
 }
 
 /// Solid angle of a cell of `row`. Twin of WGSL `cell_solid_angle`.
@@ -141,10 +142,10 @@ pub fn sample_env_map(scene: &CpuScene, params: &GpuRenderParams, u: Vec2) -> (V
     let rows = params.env_height - 1;
     let u0 = u.x.min(0.999_999_94);
     let u1 = u.y.min(0.999_999_94);
-    let row = cdf_search(d, 0, rows, u0);
+    let row = cdf_search(scene, 0, rows, 0, u0);
     let p_row = cdf_pmf(d, 0, row);
     let start = rows + params.env_height + row * w;
-    let column = cdf_search(d, start, w, u1);
+    let column = cdf_search(scene, start, w, rows + 1 + row * (w + 1), u1);
     let p_column = cdf_pmf(d, start, column);
     let r0 = ((u0 - (d[row as usize] - p_row)) / p_row).clamp(0.0, 1.0);
     let r1 = ((u1 - (d[(start + column) as usize] - p_column)) / p_column).clamp(0.0, 1.0);

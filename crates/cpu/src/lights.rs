@@ -11,6 +11,7 @@ use crate::area_light::{area_light_pdf, sample_area_light};
 use crate::cpu_scene::CpuScene;
 use crate::environment::sample_environment;
 use crate::light_sample::{INVALID, LightSample};
+use crate::sampling::first_above;
 
 /// Density (solid angle, including the choice of the light) with which [`sample_light`]
 /// from `p` gives point `p_light` (normal `n_light`) of the emitter a ray hit: triangle
@@ -59,16 +60,10 @@ pub fn sample_light(
     }
     let u_light = ((u_select - params.env_pmf) / (1.0 - params.env_pmf)).min(0.999_999_94);
     // First entry whose cumulative probability exceeds u_light.
-    let (mut lo, mut hi) = (0u32, params.light_count - 1);
-    while lo < hi {
-        let mid = (lo + hi) / 2;
-        if scene.lights[mid as usize].cdf > u_light {
-            hi = mid;
-        } else {
-            lo = mid + 1;
-        }
-    }
-    let light = scene.lights[lo as usize];
+    let entry = first_above(params.light_count, u_light, |i| {
+        scene.lights[i as usize].cdf
+    });
+    let light = scene.lights[entry as usize];
     // The part of u_light inside the chosen entry, for the light's own choices.
     let below = light.cdf - light.pmf;
     let u_part = ((u_light - below) / light.pmf.max(1e-30)).clamp(0.0, 1.0);

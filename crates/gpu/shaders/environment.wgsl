@@ -107,17 +107,15 @@ fn cdf_pmf(start: u32, k: u32) -> f32 {
 // First entry of the `n`-entry CDF at `start` exceeding u.
 // CPU twin: `cdf_search`.
 fn cdf_search(start: u32, n: u32, u: f32) -> u32 {
-    var lo = 0u;
-    var hi = n - 1u;
-    while lo < hi {
-        let mid = (lo + hi) / 2u;
-        if env_distribution[start + mid] > u {
-            hi = mid;
-        } else {
-            lo = mid + 1u;
-        }
+    // A window of fixed sizes halved: the steps do not depend on the data.
+    var base = 0u;
+    var size = n;
+    while size > 1u {
+        let half = size / 2u;
+        base += select(0u, half, env_distribution[start + base + half - 1u] <= u);
+        size -= half;
     }
-    return lo;
+    return base;
 }
 
 // Solid angle of a cell of `row`.

@@ -44,17 +44,16 @@ fn sample_light(p: vec3f, n: vec3f, u_select: f32, u: vec2f) -> LightSample {
         return invalid_light_sample();
     }
     let u_light = min((u_select - params.env_pmf) / (1.0 - params.env_pmf), 0.99999994);
-    var lo = 0u;
-    var hi = params.light_count - 1u;
-    while lo < hi {
-        let mid = (lo + hi) / 2u;
-        if lights[mid].cdf > u_light {
-            hi = mid;
-        } else {
-            lo = mid + 1u;
-        }
+    // The first entry whose cumulative probability exceeds u_light (the last when none
+    // does): a window of fixed sizes halved, the steps not depending on the data.
+    var base = 0u;
+    var size = params.light_count;
+    while size > 1u {
+        let half = size / 2u;
+        base += select(0u, half, lights[base + half - 1u].cdf <= u_light);
+        size -= half;
     }
-    let light = lights[lo];
+    let light = lights[base];
     // The part of u_light inside the chosen entry, for the light's own choices.
     let below = light.cdf - light.pmf;
     let u_part = clamp((u_light - below) / max(light.pmf, 1e-30), 0.0, 1.0);
