@@ -6,10 +6,13 @@
 //!   `F0 = m c + (1 - m)(1 - t) f0` rising to `F90 = m + (1 - m)(1 - t)` at grazing angles:
 //!   glTF's mix of the metal (F0 = c) and the dielectric (F0 = f0) specular, Schlick being
 //!   linear in F0;
-//! - a diffuse base `(1 - m)(1 - t) c / pi (1 - F(cos_o))(1 - F(cos_i))`, F the dielectric
-//!   Schlick Fresnel: light the specular layer reflects never reaches it, so the material
-//!   never reflects more than it receives (the coupling Mitsuba's `plastic` uses, without
-//!   its internal-reflection term);
+//! - a diffuse base `(1 - m)(1 - t) c / pi (1 - F(wo.h))`, F the dielectric Schlick
+//!   Fresnel and h the half vector of `wo` and `wi`: the glTF specification's
+//!   `fresnel_mix` (Appendix B). Like the specification's, this model reflects more than it
+//!   receives where the specular lobe is strong and the diffuse weight stays near
+//!   `1 - f0`: glossy dielectrics seen at grazing angles (a white one of roughness 0.2 at
+//!   `cos_o` 0.18 reflects 1.30 of what it receives, 1.03 at `cos_o` 0.5; at roughness 1
+//!   at most 0.98; docs/scene-format.md has the table);
 //! - a dielectric interface weighted `(1 - m) t` (`KHR_materials_transmission`): a thin wall
 //!   (exact Fresnel; the transmitted direction is the reflected one mirrored through the
 //!   surface, tinted by `c`; smooth, it passes straight through) or, with
@@ -160,7 +163,8 @@ pub fn eval(m: &MetalRoughParams, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3
     let wo_l = frame.to_local(wo);
     if wi.dot(ng) > 0.0 && cos_i > 0.0 {
         if l.diffuse > 0.0 {
-            let coupling = (1.0 - schlick_d(l.f0_d, cos_o)) * (1.0 - schlick_d(l.f0_d, cos_i));
+            // glTF's fresnel_mix: what the specular layer's Fresnel at the half vector passes.
+            let coupling = 1.0 - schlick_d(l.f0_d, wo.dot((wo + wi).normalize()));
             out.f += l.diffuse * coupling * color * (cos_i * FRAC_1_PI);
             out.pdf += probs.y * cos_i * FRAC_1_PI;
         }

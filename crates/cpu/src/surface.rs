@@ -53,6 +53,29 @@ fn normal_mapped(
     n.normalize()
 }
 
+/// `n` turned towards `ng` (both on the side of the unit `wo`) just enough that the mirror
+/// reflection of `wo` about it leaves the surface at least as steeply as min(0.9 wo.ng,
+/// 0.01): a normal map's normal that would reflect into the surface otherwise leaves black
+/// rims. Cycles' `ensure_valid_specular_reflection`: the new normal stays in the plane of
+/// `n` and `ng`, its height over the surface the one root of the quartic that lifts the
+/// reflection to the threshold. Twin of WGSL `valid_reflection_normal`.
+#[inline(always)]
+fn valid_reflection_normal(ng: Vec3A, wo: Vec3A, n: Vec3A) -> Vec3A {
+    let iz = wo.dot(ng);
+    let threshold = (0.9 * iz).min(0.01);
+    if (2.0 * n.dot(wo) * n - wo).dot(ng) >= threshold || iz <= 0.0 {
+        return n;
+    }
+    let x = (n - n.dot(ng) * ng).normalize_or_zero();
+    let ix = wo.dot(x);
+    let a = ix * ix + iz * iz;
+    let b = 2.0 * (a + iz * threshold);
+    let c = (threshold + iz) * (threshold + iz);
+    let root = (b * b - 4.0 * a * c).max(0.0).sqrt();
+    let nz2 = 0.25 * (if ix < 0.0 { b + root } else { b - root }) / a;
+    (1.0 - nz2).max(0.0).sqrt() * x + nz2.max(0.0).sqrt() * ng
+}
+
 /// Twin of WGSL `surface_at`, except that sphere and cylinder texture coordinates (`atan2`,
 /// `acos`) are computed only for materials with a texture, the only ones that read them
 /// (zero otherwise).
@@ -132,6 +155,9 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
                     + hit.b1 * decode(v1.tangent)
                     + hit.b2 * decode(v2.tangent);
                 s.ns = normal_mapped(scene, m, s.uv, s.ns, tangent, v0.tangent_sign);
+                let wo = -Vec3A::from(ray.dir);
+                let side = if wo.dot(s.ng) >= 0.0 { 1.0 } else { -1.0 };
+                s.ns = side * valid_reflection_normal(side * s.ng, wo, side * s.ns);
             }
             if s.ns.dot(s.ng) < 0.0 {
                 s.ns = -s.ns;

@@ -1,7 +1,7 @@
 // glTF 2.0's metallic-roughness material model. CPU twin: `crates/cpu/src/metal_rough.rs`,
 // whose header states the model: a mixture of a GGX specular lobe with Schlick Fresnel, a
-// diffuse base coupled to it and a dielectric wall (transmission), weighted by metallic and
-// transmission.
+// diffuse base under it weighted as glTF's `fresnel_mix` and a dielectric wall
+// (transmission), weighted by metallic and transmission.
 
 #import scene
 #import textures
@@ -100,7 +100,8 @@ fn eval_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, wi
     let wo_l = to_local(frame, wo);
     if dot(wi, ng) > 0.0 && cos_i > 0.0 {
         if l.diffuse > 0.0 {
-            let coupling = (1.0 - schlick(vec3f(l.f0_d), 1.0, cos_o).x) * (1.0 - schlick(vec3f(l.f0_d), 1.0, cos_i).x);
+            // glTF's fresnel_mix: what the specular layer's Fresnel at the half vector passes.
+            let coupling = 1.0 - schlick(vec3f(l.f0_d), 1.0, dot(wo, normalize(wo + wi))).x;
             out.f += l.diffuse * coupling * color * (cos_i / PI);
             out.pdf += probs.y * cos_i / PI;
         }

@@ -49,6 +49,27 @@ fn normal_mapped(m: Material, uv: vec2f, ns: vec3f, tangent: vec3f, sign: f32) -
     return normalize(n);
 }
 
+// `n` turned towards `ng` (both on the side of the unit `wo`) just enough that the mirror
+// reflection of `wo` about it leaves the surface at least as steeply as
+// min(0.9 wo.ng, 0.01) (Cycles' `ensure_valid_specular_reflection`).
+// CPU twin: `valid_reflection_normal`.
+fn valid_reflection_normal(ng: vec3f, wo: vec3f, n: vec3f) -> vec3f {
+    let iz = dot(wo, ng);
+    let threshold = min(0.9 * iz, 0.01);
+    if dot(2.0 * dot(n, wo) * n - wo, ng) >= threshold || iz <= 0.0 {
+        return n;
+    }
+    let x0 = n - dot(n, ng) * ng;
+    let x = select(vec3f(0.0), normalize(x0), dot(x0, x0) > 0.0);
+    let ix = dot(wo, x);
+    let a = ix * ix + iz * iz;
+    let b = 2.0 * (a + iz * threshold);
+    let c = (threshold + iz) * (threshold + iz);
+    let root = sqrt(max(b * b - 4.0 * a * c, 0.0));
+    let nz2 = 0.25 * select(b - root, b + root, ix < 0.0) / a;
+    return sqrt(max(1.0 - nz2, 0.0)) * x + sqrt(max(nz2, 0.0)) * ng;
+}
+
 // CPU twin: `surface_at`.
 fn surface_at(hit: Hit, ray: Ray) -> Surface {
     let o = objects[hit.object];
@@ -104,6 +125,9 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
             if has_texture(m, TEXTURE_NORMAL) {
                 let tangent = b0 * decode_unit(v0.tangent) + hit.b1 * decode_unit(v1.tangent) + hit.b2 * decode_unit(v2.tangent);
                 s.ns = normal_mapped(m, s.uv, s.ns, tangent, v0.tangent_sign);
+                let wo = -ray.dir;
+                let side = select(-1.0, 1.0, dot(wo, s.ng) >= 0.0);
+                s.ns = side * valid_reflection_normal(side * s.ng, wo, side * s.ns);
             }
             if dot(s.ns, s.ng) < 0.0 {
                 s.ns = -s.ns;

@@ -15,7 +15,8 @@ pub struct TriangleMesh {
     pub indices: Vec<[u32; 3]>,
     /// Per triangle corner (three per triangle, in `indices` order), the tangent along
     /// +u and in `w` the sign of the bitangent (`cross(normal, tangent) * w` points along
-    /// +v); empty when no material of the mesh needs them (normal maps do).
+    /// -v, up in the image, glTF's convention); empty when no material of the mesh needs
+    /// them (normal maps do).
     pub tangents: Vec<Vec4>,
     /// Shade with the geometric normal instead of `normals`.
     pub flat: bool,

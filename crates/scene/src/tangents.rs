@@ -1,4 +1,10 @@
 //! MikkTSpace tangents, the frame glTF normal maps are baked in (`bevy_mikktspace`).
+//!
+//! glTF's texture coordinate v grows downwards in the image, while its normal textures hold
+//! +Y up in the image (glTF 2.0, 3.9.3); Blender, which bakes most of them, generates its
+//! tangents with v pointing up. MikkTSpace is therefore given (u, 1 - v), so that the
+//! bitangent `cross(normal, tangent) * w` points up in the image as in files that ship their
+//! `TANGENT`.
 
 use glam::Vec4;
 
@@ -28,7 +34,8 @@ impl bevy_mikktspace::Geometry for MikkMesh<'_> {
     }
 
     fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
-        self.mesh.uvs[self.mesh.indices[face][vert] as usize].to_array()
+        let uv = self.mesh.uvs[self.mesh.indices[face][vert] as usize];
+        [uv.x, 1.0 - uv.y]
     }
 
     fn set_tangent(
@@ -79,8 +86,9 @@ mod tests {
     }
 
     #[test]
-    fn a_flat_quad_gets_the_direction_of_u_and_the_bitangent_sign_of_v() {
-        // A quad in the xy plane facing +z, u along a rotated axis, v flipped (w = -1).
+    fn a_flat_quad_gets_the_direction_of_u_and_a_bitangent_up_the_image() {
+        // A quad in the xy plane facing +z, u along a rotated axis, v mirrored: the image's
+        // up (-v) is cross(z, tangent), w = 1.
         let angle = 0.6f32;
         let (s, c) = angle.sin_cos();
         let positions = vec![
@@ -113,8 +121,8 @@ mod tests {
                 t.truncate().distance(expected) < 1e-5,
                 "corner {i}: {t} vs {expected}"
             );
-            // d(position)/dv = -(s, c, 0) = -cross(z, tangent): w = -1.
-            assert_eq!(t.w, -1.0, "corner {i}");
+            // d(position)/d(-v) = (s, c, 0) = cross(z, tangent): w = 1.
+            assert_eq!(t.w, 1.0, "corner {i}");
         }
         // The hand-computed tangent itself: d(position)/du = (c, -s, 0).
         assert!(

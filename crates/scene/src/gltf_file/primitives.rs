@@ -243,7 +243,8 @@ mod tests {
             normals: vec![Vec3::Z; 3],
             uvs: vec![Vec2::ZERO, Vec2::X, Vec2::Y],
             indices: vec![[0, 1, 2]],
-            tangents: vec![Vec4::new(1.0, 0.0, 0.0, 1.0); 3],
+            // Bitangent cross(z, x) * w = -y, towards -v: up in the image.
+            tangents: vec![Vec4::new(1.0, 0.0, 0.0, -1.0); 3],
             flat: false,
         };
         // Mirror x and move: the triangle's front (+z) must still be counter-clockwise.
@@ -257,10 +258,10 @@ mod tests {
         );
         assert_eq!(mesh.indices[0], [0, 2, 1]);
         for t in &mesh.tangents {
-            assert_eq!(*t, Vec4::new(-1.0, 0.0, 0.0, -1.0));
+            assert_eq!(*t, Vec4::new(-1.0, 0.0, 0.0, 1.0));
         }
-        // +v (the mirrored +y) = cross(n, t) * w.
+        // -v (still -y, the mirror being in x) = cross(n, t) * w.
         let bitangent = mesh.normals[0].cross(mesh.tangents[0].truncate()) * mesh.tangents[0].w;
-        assert!(bitangent.distance(Vec3::Y) < 1e-6, "{bitangent}");
+        assert!(bitangent.distance(Vec3::NEG_Y) < 1e-6, "{bitangent}");
     }
 }
