@@ -73,7 +73,45 @@ pub fn env_radiance(scene: &CpuScene, params: &GpuRenderParams, dir: Vec3A) -> V
     if !has_env_map(params) {
         return Vec3A::from(params.environment);
     }
+    cell_radiance(
+        scene,
+        params,
+        &map_cell(params, map_uv(to_map(params, dir))),
+    )
+}
+
+/// What a path escaping along world direction `dir` from a point of normal `n` sees: the
+/// radiance and, when `mis`, the density [`env_pdf`] gives the direction (0 otherwise).
+/// The same values as those two functions, the map's coordinates computed once. Twin of
+/// WGSL `env_escape`.
+#[inline(always)]
+pub fn env_escape(
+    scene: &CpuScene,
+    params: &GpuRenderParams,
+    n: Vec3A,
+    dir: Vec3A,
+    mis: bool,
+) -> (Vec3A, f32) {
+    if !has_env_map(params) {
+        let pdf = if mis {
+            env_pdf(scene, params, n, dir)
+        } else {
+            0.0
+        };
+        return (Vec3A::from(params.environment), pdf);
+    }
     let c = map_cell(params, map_uv(to_map(params, dir)));
+    let pdf = if mis {
+        params.env_pmf * cell_pdf(scene, params, &c)
+    } else {
+        0.0
+    };
+    (cell_radiance(scene, params, &c), pdf)
+}
+
+/// The map's bilinear radiance at `c`. Twin of WGSL `cell_radiance`.
+#[inline(always)]
+fn cell_radiance(scene: &CpuScene, params: &GpuRenderParams, c: &MapCell) -> Vec3A {
     let w = params.env_width;
     let right = if c.column + 1 == w { 0 } else { c.column + 1 };
     let top = c.row * w;
@@ -125,8 +163,17 @@ fn cell_solid_angle(d: &[f32], params: &GpuRenderParams, row: u32) -> f32 {
 /// `env_map_pdf`.
 #[inline(always)]
 pub fn env_map_pdf(scene: &CpuScene, params: &GpuRenderParams, dir: Vec3A) -> f32 {
+    cell_pdf(
+        scene,
+        params,
+        &map_cell(params, map_uv(to_map(params, dir))),
+    )
+}
+
+/// The map's sampling density (solid angle) in cell `c`. Twin of WGSL `cell_pdf`.
+#[inline(always)]
+fn cell_pdf(scene: &CpuScene, params: &GpuRenderParams, c: &MapCell) -> f32 {
     let d = scene.env_distribution;
-    let c = map_cell(params, map_uv(to_map(params, dir)));
     let rows = params.env_height - 1;
     let conditional = rows + params.env_height + c.row * params.env_width;
     let p = cdf_pmf(d, 0, c.row) * cdf_pmf(d, conditional, c.column);

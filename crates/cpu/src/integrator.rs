@@ -7,7 +7,7 @@ use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams, NO_
 use crate::bvh::Hit;
 use crate::camera::camera_ray;
 use crate::cpu_scene::CpuScene;
-use crate::environment::{env_pdf, env_radiance};
+use crate::environment::env_escape;
 use crate::intersect::Ray;
 use crate::light_sample::LightSample;
 use crate::lights::{light_pdf, sample_light};
@@ -147,15 +147,18 @@ impl Path {
         self.sample.rays += 1;
         let ray = self.ray;
         let Some(hit) = hit else {
+            let (env, pdf) = env_escape(
+                scene,
+                params,
+                self.prev_normal,
+                ray.dir.into(),
+                !self.prev_delta,
+            );
             let w = if self.prev_delta {
                 1.0
             } else {
-                power_heuristic(
-                    self.prev_pdf,
-                    env_pdf(scene, params, self.prev_normal, ray.dir.into()),
-                )
+                power_heuristic(self.prev_pdf, pdf)
             };
-            let env = env_radiance(scene, params, ray.dir.into());
             self.sample.radiance += self.throughput * env * w;
             if self.aov_pending {
                 self.sample.albedo = self.aov_weight * env.clamp(Vec3A::ZERO, Vec3A::ONE);

@@ -82,7 +82,29 @@ fn env_radiance(dir: vec3f) -> vec3f {
     if !has_env_map() {
         return params.environment;
     }
+    return cell_radiance(map_cell(map_uv(to_map(dir))));
+}
+
+// What a path escaping along world direction `dir` from a point of normal `n` sees: the
+// radiance and, when `mis`, the density `env_pdf` gives the direction (0 otherwise), the
+// map's coordinates computed once.
+struct EnvEscape {
+    radiance: vec3f,
+    pdf: f32,
+}
+
+// CPU twin: `env_escape`.
+fn env_escape(n: vec3f, dir: vec3f, mis: bool) -> EnvEscape {
+    if !has_env_map() {
+        return EnvEscape(params.environment, select(0.0, env_pdf(n, dir), mis));
+    }
     let c = map_cell(map_uv(to_map(dir)));
+    return EnvEscape(cell_radiance(c), select(0.0, params.env_pmf * cell_pdf(c), mis));
+}
+
+// The map's bilinear radiance at `c`.
+// CPU twin: `cell_radiance`.
+fn cell_radiance(c: MapCell) -> vec3f {
     let w = params.env_width;
     let right = select(c.column + 1u, 0u, c.column + 1u == w);
     let top = c.row * w;
@@ -128,7 +150,12 @@ fn cell_solid_angle(row: u32) -> f32 {
 // Solid-angle density of sampling world direction `dir` from the map.
 // CPU twin: `env_map_pdf`.
 fn env_map_pdf(dir: vec3f) -> f32 {
-    let c = map_cell(map_uv(to_map(dir)));
+    return cell_pdf(map_cell(map_uv(to_map(dir))));
+}
+
+// The map's sampling density (solid angle) in cell `c`.
+// CPU twin: `cell_pdf`.
+fn cell_pdf(c: MapCell) -> f32 {
     let rows = params.env_height - 1u;
     let p = cdf_pmf(0u, c.row) * cdf_pmf(rows + params.env_height + c.row * params.env_width, c.column);
     return p / cell_solid_angle(c.row);

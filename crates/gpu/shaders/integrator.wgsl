@@ -159,11 +159,12 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> PathResult {
         }
         extend = false;
         if hit.object == NO_HIT {
+            let escape = env_escape(prev_normal, ray.dir, !prev_delta);
             var w = 1.0;
             if !prev_delta {
-                w = power_heuristic(prev_pdf, env_pdf(prev_normal, ray.dir));
+                w = power_heuristic(prev_pdf, escape.pdf);
             }
-            let env = env_radiance(ray.dir);
+            let env = escape.radiance;
             radiance += throughput * env * w;
             if aov_pending {
                 albedo = aov_weight * saturate(env);
