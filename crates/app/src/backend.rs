@@ -4,6 +4,7 @@
 use std::sync::Arc;
 
 use anyhow::Context;
+use glam::Vec3;
 use pathlight_core::{PreparedScene, Renderer};
 use pathlight_cpu::{CpuRenderer, InstructionSet};
 use pathlight_gpu::context::{AutoChoice, auto_choice, available_adapters, describe};
@@ -13,7 +14,7 @@ use pathlight_scene::settings::{
     check_resolution,
 };
 use pathlight_scene::{
-    Environment, HdrImage, Sampler, Scene, default_scene, gltf_scene, load_scene_file,
+    Environment, GREY_SKY, HdrImage, Sampler, Scene, default_scene, gltf_scene, load_scene_file,
 };
 
 use crate::cli::{Backend, DeviceArgs, SamplerChoice, SceneArgs};
@@ -25,8 +26,18 @@ pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Scene> {
     if args.camera.is_some() && !gltf {
         anyhow::bail!("--camera chooses a camera of a glTF file (.gltf, .glb)");
     }
+    if args.no_default_env && !gltf {
+        anyhow::bail!("--no-default-env removes the sky added to a glTF file (.gltf, .glb)");
+    }
+    if args.no_default_env && args.env.is_some() {
+        anyhow::bail!("--no-default-env and --env: the map would replace the default sky anyway");
+    }
     let mut scene = match &args.scene {
-        Some(path) if gltf => gltf_scene(path, args.camera)?,
+        Some(path) if gltf => {
+            let mut scene = gltf_scene(path, args.camera)?;
+            choose_gltf_lighting(&mut scene, args);
+            scene
+        }
         Some(path) => load_scene_file(path)?,
         None => default_scene::load().context("the built-in default scene")?,
     };
@@ -53,6 +64,44 @@ pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Scene> {
     apply_environment(&mut scene, args)?;
     apply_lens(&mut scene, args)?;
     Ok(scene)
+}
+
+/// The lighting of a glTF file opened on its own, said in one line: the grey sky
+/// `gltf_scene` adds, replaced by `--env`, or removed by `--no-default-env` (leaving the
+/// file's emissive materials, warned about when there are none).
+fn choose_gltf_lighting(scene: &mut Scene, args: &SceneArgs) {
+    let emitters = scene
+        .materials
+        .iter()
+        .filter(|m| m.emission.max_element() > 0.0)
+        .count();
+    let own = match emitters {
+        1 => "the file's emissive material".to_string(),
+        n => format!("the file's {n} emissive materials"),
+    };
+    let also = if emitters == 0 {
+        String::new()
+    } else {
+        format!(" and {own}")
+    };
+    if args.env.is_some() {
+        note!("lighting: the --env map{also}");
+    } else if args.no_default_env {
+        scene.environment = Environment::Constant(Vec3::ZERO);
+        if emitters == 0 {
+            note!(
+                "lighting: none (--no-default-env, and nothing in the file emits): the image \
+                 will be black"
+            );
+        } else {
+            note!("lighting: {own} alone (--no-default-env)");
+        }
+    } else {
+        note!(
+            "lighting: a uniform grey sky of radiance {GREY_SKY}{also} (glTF lights are not \
+             read; --env FILE lights it with a map, --no-default-env with its emitters alone)"
+        );
+    }
 }
 
 /// Whether `path` names a glTF file (by its extension, `.gltf` or `.glb`, any case).
@@ -149,7 +198,9 @@ impl Device {
     pub fn describe(&self) -> String {
         match self {
             Device::Gpu(ctx) => describe(&ctx.adapter_info),
-            Device::Cpu => pathlight_cpu::describe(InstructionSet::best()),
+            Device::Cpu => {
+                pathlight_cpu::describe(cpu_level().unwrap_or_else(|_| InstructionSet::best()))
+            }
         }
     }
 
@@ -168,9 +219,41 @@ impl Device {
                 "--accel {} needs the GPU backend; the CPU backend has only the BVH",
                 accel.name()
             ),
-            Device::Cpu => Box::new(CpuRenderer::new(prepared, camera, settings)),
+            Device::Cpu => Box::new(cpu_renderer(scene, prepared)?),
         })
     }
+}
+
+/// The variable naming the CPU backend's level, for comparing levels on one machine.
+pub const CPU_LEVEL_VARIABLE: &str = "PATHLIGHT_CPU_LEVEL";
+
+/// The level the CPU backend runs: the best this CPU has, or the one [`CPU_LEVEL_VARIABLE`]
+/// names when set and not empty (refused, with the levels there are, when this CPU cannot
+/// run it).
+pub fn cpu_level() -> anyhow::Result<InstructionSet> {
+    let name = std::env::var_os(CPU_LEVEL_VARIABLE).unwrap_or_default();
+    let name = name.to_string_lossy();
+    if name.is_empty() {
+        return Ok(InstructionSet::best());
+    }
+    InstructionSet::named(&name).ok_or_else(|| {
+        let levels: Vec<&str> = InstructionSet::supported()
+            .iter()
+            .map(|level| level.name())
+            .collect();
+        anyhow::anyhow!(
+            "{CPU_LEVEL_VARIABLE}={name}: this CPU runs the levels {}",
+            levels.join(", ")
+        )
+    })
+}
+
+/// The CPU backend renderer of `prepared` as `scene`'s camera and settings ask, running
+/// [`cpu_level`].
+pub fn cpu_renderer(scene: &Scene, prepared: &PreparedScene) -> anyhow::Result<CpuRenderer> {
+    let mut renderer = CpuRenderer::new(prepared, &scene.camera, &scene.settings);
+    renderer.set_instruction_set(cpu_level()?)?;
+    Ok(renderer)
 }
 
 /// Why `--backend auto` chose what it did, in one line.
@@ -181,7 +264,8 @@ pub fn explain(choice: AutoChoice, adapters: &[wgpu::AdapterInfo]) -> String {
             adapters[i].name
         ),
         AutoChoice::Cpu(software) => {
-            let cpu = pathlight_cpu::threads_and_level(InstructionSet::best());
+            let level = cpu_level().unwrap_or_else(|_| InstructionSet::best());
+            let cpu = pathlight_cpu::threads_and_level(level);
             let forced = match software {
                 Some(i) => format!("--backend gpu forces {}", adapters[i].name),
                 None => "no adapter for --backend gpu".to_string(),

@@ -108,6 +108,10 @@ pub struct SceneArgs {
     /// scene's `[environment]`).
     #[arg(long, value_name = "FILE")]
     pub env: Option<PathBuf>,
+    /// Light a glTF file opened on its own by its emitters alone, without the uniform grey
+    /// sky added to it (for a closed room lit by its own panels).
+    #[arg(long)]
+    pub no_default_env: bool,
     /// Factor on the environment map's texels (with `--env`, or on the scene's map).
     #[arg(long, value_name = "FACTOR", allow_hyphen_values = true)]
     pub env_strength: Option<f32>,
@@ -331,6 +335,7 @@ impl ViewArgs {
                 max_depth: None,
                 sampler: None,
                 env: None,
+                no_default_env: false,
                 env_strength: None,
                 env_rotation: None,
                 aperture: None,

@@ -96,9 +96,21 @@ fn encode(film: &Film, format: Format) -> anyhow::Result<Vec<u8>> {
 }
 
 /// Replaces (or creates) `path` with `bytes` atomically: a temporary file beside it is
-/// written, flushed to the disk and renamed over it.
+/// written, flushed to the disk and renamed over it. The file keeps the permissions of the
+/// one it replaces; a new one gets what any program's new file gets (read and write for
+/// all, less the umask), not the temporary file's owner-only ones.
 fn replace_file(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let mut file = tempfile::NamedTempFile::new_in(folder_of(path))?;
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let permissions = match std::fs::metadata(path) {
+            Ok(existing) => existing.permissions(),
+            Err(_) => std::fs::Permissions::from_mode(0o666),
+        };
+        builder.permissions(permissions);
+    }
+    let mut file = builder.tempfile_in(folder_of(path))?;
     file.write_all(bytes)?;
     file.as_file().sync_all()?;
     file.persist(path)?;
@@ -210,4 +222,36 @@ pub fn sibling_path(path: &Path, name: &str) -> std::path::PathBuf {
 pub fn read_state(path: &Path) -> anyhow::Result<RenderState> {
     let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
     RenderState::decode(&bytes).with_context(|| format!("{}", path.display()))
+}
+
+#[cfg(all(test, unix))]
+mod tests {
+    use std::os::unix::fs::PermissionsExt;
+
+    use super::*;
+
+    fn mode(path: &Path) -> u32 {
+        std::fs::metadata(path).unwrap().permissions().mode() & 0o777
+    }
+
+    /// A new output gets the mode any new file gets here (0o666 less the umask, as
+    /// `File::create` shows), not the temporary file's 0o600; a replaced one keeps its own.
+    #[test]
+    fn outputs_get_the_usual_permissions_and_replacements_keep_theirs() {
+        let dir = tempfile::tempdir().unwrap();
+        let usual = dir.path().join("usual");
+        std::fs::File::create(&usual).unwrap();
+        let new = dir.path().join("new.png");
+        replace_file(&new, b"one").unwrap();
+        assert_eq!(mode(&new), mode(&usual));
+        assert_ne!(
+            mode(&new),
+            0o600,
+            "a umask of 0o177 would hide the difference"
+        );
+        std::fs::set_permissions(&new, std::fs::Permissions::from_mode(0o640)).unwrap();
+        replace_file(&new, b"two").unwrap();
+        assert_eq!(mode(&new), 0o640);
+        assert_eq!(std::fs::read(&new).unwrap(), b"two");
+    }
 }

@@ -630,3 +630,115 @@ fn gltf_files_render_directly_and_camera_numbers_are_checked() {
         &["RecursiveNodes.gltf: node 0: is its own ancestor"],
     );
 }
+
+/// `PATHLIGHT_CPU_LEVEL` runs the CPU backend at the level it names (the report says which)
+/// with the same image bit for bit as the best level; a level this CPU cannot run, or no
+/// level at all, is refused naming the levels there are.
+#[test]
+fn the_cpu_level_variable_picks_the_level_and_keeps_the_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = |level: Option<&str>, name: &str| {
+        let out = dir.path().join(name);
+        let mut command = Command::new(env!("CARGO_BIN_EXE_pathlight"));
+        command
+            .args(["render", "scenes/refs/cornell-spheres.toml", "--spp", "2"])
+            .args(SMALL_ON_CPU)
+            .arg("-o")
+            .arg(&out)
+            .current_dir(repo());
+        match level {
+            Some(level) => command.env("PATHLIGHT_CPU_LEVEL", level),
+            None => command.env_remove("PATHLIGHT_CPU_LEVEL"),
+        };
+        let output = command.output().unwrap();
+        (output, out)
+    };
+    let (best, best_image) = render(None, "best.exr");
+    assert!(best.status.success(), "{}", stderr(&best));
+    let (baseline, baseline_image) = render(Some("baseline"), "baseline.exr");
+    let err = stderr(&baseline);
+    assert!(baseline.status.success(), "{err}");
+    assert!(
+        err.contains("cpu backend, ") && err.contains(", baseline"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(&best_image).unwrap(),
+        std::fs::read(&baseline_image).unwrap(),
+        "the levels' images differ"
+    );
+    let (refused, _) = render(Some("x86-64-v9"), "refused.exr");
+    let err = stderr(&refused);
+    assert_eq!(refused.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("PATHLIGHT_CPU_LEVEL=x86-64-v9") && err.contains("baseline"),
+        "{err}"
+    );
+}
+
+/// A glTF file opened on its own is lit by the grey sky even when it has emitters (glTF
+/// viewers light a model), saying so; `--no-default-env` leaves its emitters alone; the flag
+/// is refused for a TOML scene and beside `--env`.
+#[test]
+fn a_gltf_file_opens_lit_unless_told_otherwise() {
+    let dir = tempfile::tempdir().unwrap();
+    let positions: [f32; 9] = [-1.0, -1.0, 0.0, 1.0, -1.0, 0.0, 0.0, 1.0, 0.0];
+    let bytes: Vec<u8> = positions.iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(dir.path().join("panel.bin"), bytes).unwrap();
+    let gltf = dir.path().join("panel.gltf");
+    std::fs::write(
+        &gltf,
+        r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "material": 0}]}],
+        "materials": [{"emissiveFactor": [1, 1, 1]}],
+        "buffers": [{"byteLength": 36, "uri": "panel.bin"}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+            "min": [-1, -1, 0], "max": [1, 1, 0]}]}"#,
+    )
+    .unwrap();
+    let render = |extra: &[&str], name: &str| {
+        let out = dir.path().join(name);
+        let mut args = vec!["render", gltf.to_str().unwrap(), "--spp", "2"];
+        args.extend(SMALL_ON_CPU);
+        args.extend(extra);
+        args.extend(["-o", out.to_str().unwrap()]);
+        let output = pathlight(&args);
+        let err = stderr(&output);
+        assert!(output.status.success(), "{err}");
+        (err, pathlight_core::Film::read_exr(&out).unwrap())
+    };
+    let (err, lit) = render(&[], "lit.exr");
+    assert!(
+        err.contains(
+            "lighting: a uniform grey sky of radiance 0.8 and the file's emissive material ("
+        ),
+        "{err}"
+    );
+    assert_eq!(lit.pixels[0], [0.8; 3], "the corner sees the sky");
+    let (err, alone) = render(&["--no-default-env"], "alone.exr");
+    assert!(
+        err.contains("lighting: the file's emissive material alone"),
+        "{err}"
+    );
+    assert_eq!(alone.pixels[0], [0.0; 3], "no sky");
+    assert!(
+        alone.pixels.iter().any(|p| p[0] > 0.5),
+        "the panel still shows"
+    );
+    fails_with(
+        &["render", "scenes/refs/furnace-0.8.toml", "--no-default-env"],
+        &["--no-default-env", "glTF"],
+    );
+    fails_with(
+        &[
+            "render",
+            gltf.to_str().unwrap(),
+            "--no-default-env",
+            "--env",
+            "assets/env/city.exr",
+        ],
+        &["--no-default-env and --env"],
+    );
+}

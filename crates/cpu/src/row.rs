@@ -183,6 +183,13 @@ impl InstructionSet {
         Self::supported().pop().unwrap_or(Self::Baseline)
     }
 
+    /// The level this CPU can run whose [`name`](Self::name) is `name`.
+    pub fn named(name: &str) -> Option<Self> {
+        Self::supported()
+            .into_iter()
+            .find(|level| level.name() == name)
+    }
+
     /// Its name, as reports show it.
     pub fn name(self) -> &'static str {
         match self {

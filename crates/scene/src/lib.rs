@@ -23,7 +23,7 @@ pub mod texture;
 pub use camera::Camera;
 pub use environment::{Environment, EnvironmentMap, HdrImage};
 pub use error::{RangeError, SceneError};
-pub use gltf_file::{GltfModel, gltf_scene, load_gltf};
+pub use gltf_file::{GREY_SKY, GltfModel, gltf_scene, load_gltf};
 pub use load::{SceneSource, load_scene, load_scene_file};
 pub use material::{AlphaMode, Conductor, Lobes, Material, MetalRough, Model, TextureRef, Wrap};
 pub use settings::{RenderSettings, Sampler};

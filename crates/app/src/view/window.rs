@@ -7,7 +7,6 @@ use std::time::Duration;
 
 use anyhow::anyhow;
 use pathlight_core::{PreparedScene, Renderer, ToneMap};
-use pathlight_cpu::CpuRenderer;
 use pathlight_cpu::display::ChannelOrder;
 use pathlight_gpu::context::{auto_choice, describe, is_hardware};
 use pathlight_gpu::display::DisplayPass;
@@ -17,7 +16,7 @@ use winit::dpi::PhysicalSize;
 use winit::event_loop::{ActiveEventLoop, EventLoopProxy};
 use winit::window::Window;
 
-use crate::backend::explain;
+use crate::backend::{cpu_renderer, explain};
 use crate::cli::{Backend, DeviceArgs};
 use crate::view::FrameReady;
 use crate::view::cpu_frames::CpuFrames;
@@ -89,7 +88,7 @@ impl ViewerWindow {
             };
             Box::new(GpuFrames::new(renderer, target))
         } else {
-            let renderer = CpuRenderer::new(prepared, &scene.camera, &scene.settings);
+            let renderer = cpu_renderer(scene, prepared)?;
             say!(
                 "backend: {}, presenting on {}",
                 renderer.device(),

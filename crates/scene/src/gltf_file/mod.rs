@@ -23,7 +23,7 @@ use materials::Materials;
 const MAX_DEPTH: usize = 256;
 /// Most mesh instances accepted (a node shared by many parents is placed once per path).
 const MAX_INSTANCES: usize = 1 << 20;
-/// Radiance of the grey sky that lights a model whose file has no emitters.
+/// Radiance of the grey sky that lights a glTF file opened on its own.
 pub const GREY_SKY: f32 = 0.8;
 
 /// A perspective camera of a glTF file, placed in the world.
@@ -68,13 +68,6 @@ impl GltfModel {
             .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| {
                 (lo.min(p), hi.max(p))
             })
-    }
-
-    /// Whether any material emits.
-    pub fn has_emitters(&self) -> bool {
-        self.materials
-            .iter()
-            .any(|m| m.emission.max_element() > 0.0)
     }
 }
 
@@ -266,8 +259,10 @@ impl Walk<'_> {
 }
 
 /// A scene of the glTF file `path` alone: its camera `camera` (else its first, else one
-/// framing the model from the front and a little above), its emitters or, with none, a
-/// uniform grey sky of radiance [`GREY_SKY`], and the default render settings.
+/// framing the model from the front and a little above), its emitters and a uniform grey
+/// sky of radiance [`GREY_SKY`] (as glTF viewers light a model; a file lit by its own
+/// emitters alone, a closed room, can be rendered without it), and the default render
+/// settings.
 pub fn gltf_scene(path: &Path, camera: Option<usize>) -> Result<Scene, SceneError> {
     let model = load_gltf(path, Mat4::IDENTITY)?;
     let height = 720;
@@ -287,15 +282,10 @@ pub fn gltf_scene(path: &Path, camera: Option<usize>) -> Result<Scene, SceneErro
             None => framing_camera(model.bounds(), height),
         },
     };
-    let environment = if model.has_emitters() {
-        Environment::Constant(Vec3::ZERO)
-    } else {
-        Environment::Constant(Vec3::splat(GREY_SKY))
-    };
     Ok(Scene {
         camera,
         settings: RenderSettings::from(&RenderDesc::default()),
-        environment,
+        environment: Environment::Constant(Vec3::splat(GREY_SKY)),
         materials: model.materials,
         textures: model.textures,
         objects: model.objects,
