@@ -179,6 +179,20 @@ fn sample(rng: &mut StdRng, m: &MaterialPoint, wo: Vec3A) -> BsdfSample {
     sample_material(m, &surface(), wo, rng.random(), rng.random(), u)
 }
 
+/// The red channel of `n` sampled weights at `wo` (an invalid sample weighs 0).
+fn red_weights(rng: &mut StdRng, m: &MaterialPoint, wo: Vec3A, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|_| {
+            let bs = sample(rng, m, wo);
+            if bs.valid {
+                f64::from(bs.weight.x)
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
 #[test]
 fn samples_agree_with_eval_and_pdf() {
     let mut rng = StdRng::seed_from_u64(1);
@@ -251,16 +265,7 @@ fn sampled_albedo_equals_the_integral_of_eval() {
             continue;
         }
         for wo in outgoing() {
-            let sampled: Vec<f64> = (0..N)
-                .map(|_| {
-                    let bs = sample(&mut rng, &m, wo);
-                    if bs.valid {
-                        f64::from(bs.weight.x)
-                    } else {
-                        0.0
-                    }
-                })
-                .collect();
+            let sampled = red_weights(&mut rng, &m, wo, N);
             let integrated: Vec<f64> = (0..4 * N)
                 .map(|_| {
                     let wi = sample_uniform_sphere(Vec2::new(rng.random(), rng.random()));
@@ -441,17 +446,7 @@ fn metal_rough_albedo_is_the_specifications() {
                 let m = point([c; 3], metal_rough(metallic, roughness, 0.0, true));
                 for cos in [1.0f32, 0.6, 0.2] {
                     let wo = Vec3A::new((1.0 - cos * cos).sqrt(), 0.0, cos);
-                    let weights: Vec<f64> = (0..N / 2)
-                        .map(|_| {
-                            let bs = sample(&mut rng, &m, wo);
-                            if bs.valid {
-                                f64::from(bs.weight.x)
-                            } else {
-                                0.0
-                            }
-                        })
-                        .collect();
-                    let (mean, error) = mean_and_error(&weights);
+                    let (mean, error) = mean_and_error(&red_weights(&mut rng, &m, wo, N / 2));
                     let expected =
                         gltf_albedo(f64::from(c), f64::from(metallic), f64::from(roughness), wo);
                     assert!(
