@@ -387,3 +387,42 @@ transform = { translate = [-1, 0, 0], scale = 0.5 }
         "{err}"
     );
 }
+
+/// A mesh placed by several nodes (one of them mirroring, one reached through a parent) is
+/// read once and placed by each: every copy where its node puts it, none disturbed by the
+/// others' transforms.
+#[test]
+fn a_mesh_placed_many_times_lands_where_each_node_puts_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let corners = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let nodes = r#"[{"children": [1, 2, 3]},
+        {"translation": [10, 0, 0], "mesh": 0},
+        {"matrix": [-1,0,0,0, 0,1,0,0, 0,0,1,0, 20,0,0,1], "mesh": 0},
+        {"translation": [0, 5, 0], "children": [4]},
+        {"translation": [30, 0, 0], "mesh": 0}]"#;
+    let path = triangle_gltf(dir.path(), nodes, &corners);
+    let model = load_gltf(&path, Mat4::IDENTITY).unwrap();
+    let placements = [
+        Mat4::from_translation(Vec3::new(10.0, 0.0, 0.0)),
+        Mat4::from_translation(Vec3::new(20.0, 0.0, 0.0))
+            * Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)),
+        Mat4::from_translation(Vec3::new(30.0, 5.0, 0.0)),
+    ];
+    assert_eq!(model.objects.len(), placements.len());
+    for (object, world) in model.objects.iter().zip(placements) {
+        let Shape::Mesh(mesh) = &object.shape else {
+            panic!("a mesh")
+        };
+        let mut expected: Vec<Vec3> = corners
+            .iter()
+            .map(|c| world.transform_point3(Vec3::from(*c)))
+            .collect();
+        let mut got = mesh.positions.clone();
+        let key = |v: &Vec3| (v.x * 1e3) as i64 * 1_000_000 + (v.y * 1e3) as i64;
+        expected.sort_by_key(key);
+        got.sort_by_key(key);
+        for (g, e) in got.iter().zip(&expected) {
+            assert!(g.distance(*e) < 1e-5, "{}: {g} vs {e}", object.name);
+        }
+    }
+}

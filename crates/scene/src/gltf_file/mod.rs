@@ -8,6 +8,7 @@ mod data;
 mod materials;
 mod primitives;
 
+use std::collections::HashMap;
 use std::path::Path;
 
 use glam::{Mat4, Vec3};
@@ -15,7 +16,9 @@ use glam::{Mat4, Vec3};
 use crate::desc::RenderDesc;
 use crate::error::SceneError;
 use crate::settings::MAX_COORDINATE;
-use crate::{Camera, Environment, Material, Object, RenderSettings, Scene, Shape, Texture};
+use crate::{
+    Camera, Environment, Material, Object, RenderSettings, Scene, Shape, Texture, TriangleMesh,
+};
 use data::Files;
 use materials::Materials;
 
@@ -118,10 +121,15 @@ pub fn load_gltf(path: &Path, transform: Mat4) -> Result<GltfModel, SceneError> 
         },
         ancestors: Vec::new(),
         instances: 0,
+        uses: HashMap::new(),
+        read: HashMap::new(),
         stem: path
             .file_stem()
             .map_or_else(|| "gltf".to_owned(), |s| s.to_string_lossy().into_owned()),
     };
+    for node in scene.nodes() {
+        count_uses(&node, &mut Vec::new(), &mut walk.uses);
+    }
     for node in scene.nodes() {
         walk.node(&node, transform)?;
     }
@@ -147,6 +155,32 @@ struct Walk<'a> {
     instances: usize,
     /// The file's name without extension, prefixing object names.
     stem: String,
+    /// Per mesh, the placements still to come (from [`count_uses`]).
+    uses: HashMap<usize, usize>,
+    /// Per (mesh, primitive), its triangles in the mesh's own space (`None`: skipped), read
+    /// once and kept while further placements of the mesh are to come.
+    read: HashMap<(usize, usize), Option<TriangleMesh>>,
+}
+
+/// Counts into `uses` how often each mesh is placed under `node` (a node reached again
+/// through its own descendants, or deeper than [`MAX_DEPTH`], ends the count there: the
+/// walk refuses such files).
+fn count_uses(node: &gltf::Node, ancestors: &mut Vec<usize>, uses: &mut HashMap<usize, usize>) {
+    if ancestors.contains(&node.index()) || ancestors.len() >= MAX_DEPTH {
+        return;
+    }
+    if let Some(mesh) = node.mesh() {
+        let count = uses.entry(mesh.index()).or_default();
+        if *count > MAX_INSTANCES {
+            return;
+        }
+        *count += 1;
+    }
+    ancestors.push(node.index());
+    for child in node.children() {
+        count_uses(&child, ancestors, uses);
+    }
+    ancestors.pop();
 }
 
 impl Walk<'_> {
@@ -224,19 +258,39 @@ impl Walk<'_> {
         });
     }
 
+    /// Places `mesh` by `world`: each primitive read once however often the mesh is placed
+    /// (and warned about once), copied for every placement but the last, which takes it.
     fn mesh(&mut self, mesh: &gltf::Mesh, world: Mat4) -> Result<(), SceneError> {
+        let remaining = self.uses.entry(mesh.index()).or_insert(1);
+        *remaining = remaining.saturating_sub(1);
+        let last = *remaining == 0;
         for primitive in mesh.primitives() {
             let (material, needs) =
                 self.materials
                     .get(self.files, self.buffers, &primitive.material())?;
-            let Some(mut triangles) = primitives::read_primitive(
-                self.files,
-                self.buffers,
-                mesh.index(),
-                &primitive,
-                needs,
-            )?
-            else {
+            let key = (mesh.index(), primitive.index());
+            let cached = if last {
+                self.read.remove(&key)
+            } else {
+                self.read.get(&key).cloned()
+            };
+            let triangles = match cached {
+                Some(triangles) => triangles,
+                None => {
+                    let triangles = primitives::read_primitive(
+                        self.files,
+                        self.buffers,
+                        mesh.index(),
+                        &primitive,
+                        needs,
+                    )?;
+                    if !last {
+                        self.read.insert(key, triangles.clone());
+                    }
+                    triangles
+                }
+            };
+            let Some(mut triangles) = triangles else {
                 continue;
             };
             primitives::place(&mut triangles, world);
