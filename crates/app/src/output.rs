@@ -129,7 +129,14 @@ pub fn write(film: &Film, path: &Path) -> anyhow::Result<()> {
 /// a file there only once all of it is on the disk.
 pub fn write_render(state: &RenderState, path: &Path) -> anyhow::Result<()> {
     let bytes = match format_of(path)? {
-        Format::State => state.encode(),
+        Format::State => {
+            anyhow::ensure!(
+                state.fingerprint.is_hashed(),
+                "cannot write {}: the render did not hash its scene (a bug in pathlight)",
+                path.display()
+            );
+            state.encode()
+        }
         format => encode(&state.film(), format)
             .with_context(|| format!("cannot encode {}", path.display()))?,
     };
@@ -224,8 +231,40 @@ pub fn read_state(path: &Path) -> anyhow::Result<RenderState> {
     RenderState::decode(&bytes).with_context(|| format!("{}", path.display()))
 }
 
-#[cfg(all(test, unix))]
+#[cfg(test)]
 mod tests {
+    use pathlight_core::Accumulation;
+    use pathlight_core::state::Fingerprint;
+    use pathlight_scene::{Camera, RenderSettings};
+
+    use super::*;
+
+    /// A state whose fingerprint lacks the scene's hash is not written: it would merge with
+    /// a render of any scene.
+    #[test]
+    fn a_state_without_the_scene_hash_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let camera = Camera {
+            width: 2,
+            height: 2,
+            ..pathlight_scene::default_scene::load().unwrap().camera
+        };
+        let settings = RenderSettings::from(&pathlight_scene::desc::RenderDesc::default());
+        let state = RenderState::new(
+            Fingerprint::unhashed(&camera, &settings),
+            0..1,
+            "test".into(),
+            Accumulation::empty(2, 2, 0, false),
+        );
+        let path = dir.path().join("a.state");
+        let err = write_render(&state, &path).unwrap_err().to_string();
+        assert!(err.contains("did not hash its scene"), "{err}");
+        assert!(!path.exists());
+    }
+}
+
+#[cfg(all(test, unix))]
+mod permission_tests {
     use std::os::unix::fs::PermissionsExt;
 
     use super::*;

@@ -57,7 +57,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let to_state = output::format_of(&args.output)? == output::Format::State;
     if args.denoise.is_some() && to_state {
         bail!(
-            "--denoise writes an image, not a state: render to {} without it and denoise              later with `pathlight denoise {}` (give the render --aov albedo,normal to guide it)",
+            "--denoise writes an image, not a state: render to {} without it and denoise \
+             later with `pathlight denoise {}` (give the render --aov albedo,normal to guide it)",
             args.output.display(),
             args.output.display()
         );
@@ -176,7 +177,13 @@ fn render_to_file(
 ) -> anyhow::Result<()> {
     let started = Instant::now();
     let prepared = PreparedScene::new(scene)?;
-    let fingerprint = Fingerprint::new(&prepared, &scene.camera, &scene.settings);
+    // The scene's hash only where a state is read or written.
+    let writes_state = output::format_of(&args.output)? == output::Format::State;
+    let fingerprint = if args.resume.is_some() || args.checkpoint.is_some() || writes_state {
+        Fingerprint::new(&prepared, &scene.camera, &scene.settings)
+    } else {
+        Fingerprint::unhashed(&scene.camera, &scene.settings)
+    };
     let Start {
         target,
         accumulation,

@@ -65,6 +65,19 @@ fn sha256_hex(parts: &[&[u8]]) -> String {
 }
 
 impl Fingerprint {
+    /// The fingerprint of rendering as `camera` sees it with `settings`, without the scene's
+    /// hash (`scene` empty): for a render that neither reads nor writes a state, since
+    /// hashing a large scene's buffers is a noticeable part of its first frame. A state
+    /// holding one must not be written: it would merge with any scene's.
+    pub fn unhashed(camera: &Camera, settings: &RenderSettings) -> Self {
+        Self::with_scene_hash(String::new(), camera, settings)
+    }
+
+    /// Whether the scene's hash is in it (not [`Self::unhashed`]).
+    pub fn is_hashed(&self) -> bool {
+        !self.scene.is_empty()
+    }
+
     /// The fingerprint of rendering `scene` as `camera` sees it with `settings`.
     pub fn new(scene: &PreparedScene, camera: &Camera, settings: &RenderSettings) -> Self {
         let (geometry, textures, shading) = (&scene.geometry, &scene.textures, &scene.shading);
@@ -89,6 +102,11 @@ impl Fingerprint {
             bytemuck::cast_slice(&scene.environment.distribution),
             bytemuck::cast_slice(&map_placement),
         ]);
+        Self::with_scene_hash(scene_hash, camera, settings)
+    }
+
+    /// The fingerprint with the scene's hash `scene_hash`.
+    fn with_scene_hash(scene_hash: String, camera: &Camera, settings: &RenderSettings) -> Self {
         let gpu_camera = GpuCamera::new(camera);
         Self {
             scene: scene_hash,
