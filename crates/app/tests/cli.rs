@@ -38,6 +38,19 @@ fn fails_with(args: &[&str], needles: &[&str]) -> String {
 /// The options of a 16x16 image on the CPU backend (for `render` and `bench`).
 const SMALL_ON_CPU: [&str; 6] = ["--backend", "cpu", "--width", "16", "--height", "16"];
 
+/// Renders `scene` 16x16 at 2 spp on the CPU backend with `extra` options into the EXR `out`,
+/// which must succeed: what it printed and the image.
+fn render_small(scene: &str, extra: &[&str], out: &Path) -> (String, pathlight_core::Film) {
+    let mut args = vec!["render", scene, "--spp", "2"];
+    args.extend(SMALL_ON_CPU);
+    args.extend(extra);
+    args.extend(["-o", out.to_str().unwrap()]);
+    let output = pathlight(&args);
+    let err = stderr(&output);
+    assert!(output.status.success(), "{args:?}: {err}");
+    (err, pathlight_core::Film::read_exr(out).unwrap())
+}
+
 /// Starts a 16x16 CPU render of the default scene at `spp` into `out`, stderr piped.
 fn spawn_cpu_render(spp: &str, out: &Path) -> std::process::Child {
     Command::new(env!("CARGO_BIN_EXE_pathlight"))
@@ -515,14 +528,12 @@ fn sampler_option_overrides_the_scene() {
 fn env_and_lens_options_replace_the_scenes() {
     let dir = tempfile::tempdir().unwrap();
     let render = |extra: &[&str], name: &str| {
-        let out = dir.path().join(name);
-        let mut args = vec!["render", "scenes/refs/furnace-0.8.toml", "--spp", "2"];
-        args.extend(SMALL_ON_CPU);
-        args.extend(extra);
-        args.extend(["-o", out.to_str().unwrap()]);
-        let output = pathlight(&args);
-        assert!(output.status.success(), "{args:?}: {}", stderr(&output));
-        pathlight_core::Film::read_exr(&out).unwrap()
+        render_small(
+            "scenes/refs/furnace-0.8.toml",
+            extra,
+            &dir.path().join(name),
+        )
+        .1
     };
     let plain = render(&[], "plain.exr");
     assert_eq!(plain.pixel(0, 0), [1.0; 3]);
@@ -699,15 +710,7 @@ fn a_gltf_file_opens_lit_unless_told_otherwise() {
     )
     .unwrap();
     let render = |extra: &[&str], name: &str| {
-        let out = dir.path().join(name);
-        let mut args = vec!["render", gltf.to_str().unwrap(), "--spp", "2"];
-        args.extend(SMALL_ON_CPU);
-        args.extend(extra);
-        args.extend(["-o", out.to_str().unwrap()]);
-        let output = pathlight(&args);
-        let err = stderr(&output);
-        assert!(output.status.success(), "{err}");
-        (err, pathlight_core::Film::read_exr(&out).unwrap())
+        render_small(gltf.to_str().unwrap(), extra, &dir.path().join(name))
     };
     let (err, lit) = render(&[], "lit.exr");
     assert!(

@@ -75,14 +75,19 @@ pub fn atan2(y: f32, x: f32) -> f32 {
     let (small, large) = (ax.min(ay), ax.max(ay));
     let t = if large > 0.0 { small / large } else { 0.0 };
     let t2 = t * t;
-    let p = 0.002_866_225_7f32;
-    let p = p * t2 - 0.016_165_737;
-    let p = p * t2 + 0.042_909_614;
-    let p = p * t2 - 0.075_289_64;
-    let p = p * t2 + 0.106_562_64;
-    let p = p * t2 - 0.142_089;
-    let p = p * t2 + 0.199_935_51;
-    let p = p * t2 - 0.333_331_45;
+    let p = horner(
+        t2,
+        &[
+            0.002_866_225_7,
+            -0.016_165_737,
+            0.042_909_614,
+            -0.075_289_64,
+            0.106_562_64,
+            -0.142_089,
+            0.199_935_51,
+            -0.333_331_45,
+        ],
+    );
     let mut r = t + t * t2 * p;
     if ay > ax {
         r = std::f32::consts::FRAC_PI_2 - r;
@@ -93,19 +98,31 @@ pub fn atan2(y: f32, x: f32) -> f32 {
     f32::from_bits(r.to_bits() | (y.to_bits() & 0x8000_0000))
 }
 
+/// The polynomial with coefficients `c` (highest power first) at `x`, by Horner's rule:
+/// each step a multiply, then an add (never fused, so every level rounds alike).
+#[inline(always)]
+fn horner(x: f32, c: &[f32]) -> f32 {
+    c[1..].iter().fold(c[0], |p, &k| p * x + k)
+}
+
 /// `acos(x)` for `x` in [-1, 1], to within 5e-7 rad: Abramowitz and Stegun's 4.4.46, inline
 /// (libm's `acosf` is a call). The WGSL twins call `acos`.
 #[inline(always)]
 pub fn acos(x: f32) -> f32 {
     let ax = x.abs();
-    let p = -0.001_262_491_1f32;
-    let p = p * ax + 0.006_670_09;
-    let p = p * ax - 0.017_088_126;
-    let p = p * ax + 0.030_891_88;
-    let p = p * ax - 0.050_174_305;
-    let p = p * ax + 0.088_978_99;
-    let p = p * ax - 0.214_598_8;
-    let p = p * ax + std::f32::consts::FRAC_PI_2;
+    let p = horner(
+        ax,
+        &[
+            -0.001_262_491_1,
+            0.006_670_09,
+            -0.017_088_126,
+            0.030_891_88,
+            -0.050_174_305,
+            0.088_978_99,
+            -0.214_598_8,
+            std::f32::consts::FRAC_PI_2,
+        ],
+    );
     let r = (1.0 - ax).max(0.0).sqrt() * p;
     if x < 0.0 { PI - r } else { r }
 }
