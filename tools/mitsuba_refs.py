@@ -5,7 +5,7 @@ Converts scenes/refs/NAME.toml (the subset with an exact Mitsuba equivalent: qua
 OBJ meshes with scale + translate, emissive shapes as one-sided `area` emitters, two-sided
 diffuse, smooth or GGX-rough conductors and dielectrics with alpha = roughness^2, a
 constant environment or an `envmap` with its scale and rotation about +y, a pinhole or a
-`thinlens` camera) to a Mitsuba scene and either
+`thinlens` camera, point lights, spot lights with a hard edge, directional suns) to a Mitsuba scene and either
 
   render NAME [--res 512] [--spp 1024]   writes scenes/refs/images/NAME.exr and .png: the
                                          2x2 box average of a res x res render (the
@@ -185,7 +185,33 @@ def to_mitsuba(scene, res, spp):
     for kind in ("cylinder", "revolve"):
         if scene.get(kind):
             raise SystemExit(f"{kind} shapes are not converted")
+    for i, light in enumerate(scene.get("light", [])):
+        out[f"light{i}"] = emitter(light)
     return out
+
+
+def emitter(light):
+    """A [[light]] as Mitsuba's point, spot or directional emitter (the kinds with an exact
+    equivalent: no radius, no sun disk, a spot with a hard edge)."""
+    import mitsuba as mi
+    T = mi.ScalarTransform4f
+    strength = rgb(np.array(light.get("color", [1, 1, 1]), float) * light["intensity"])
+    if light.get("radius", 0.0) or light.get("angular_diameter", 0.0):
+        raise SystemExit("lights with a radius or a sun disk are not converted")
+    if light["type"] == "point":
+        return {"type": "point", "position": light["position"], "intensity": strength}
+    if light["type"] == "sun":
+        return {"type": "directional", "direction": light["direction"], "irradiance": strength}
+    outer = light.get("outer_angle", 45.0)
+    if light.get("inner_angle", 0.0) != outer:
+        # Mitsuba's falloff is linear in the angle, glTF's (pathlight's) quadratic in a step
+        # of the cosine: only the hard edge is the same.
+        raise SystemExit("spot lights are converted with inner_angle = outer_angle only")
+    position = np.array(light["position"], float)
+    axis = np.array(light["direction"], float) if "direction" in light else np.array(light["look_at"], float) - position
+    up = [0, 1, 0] if abs(axis[1]) < 0.99 * np.linalg.norm(axis) else [1, 0, 0]
+    return {"type": "spot", "intensity": strength, "cutoff_angle": outer, "beam_width": outer,
+            "to_world": T().look_at(origin=position.tolist(), target=(position + axis).tolist(), up=up)}
 
 
 def load(name):

@@ -66,26 +66,43 @@ pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Scene> {
     Ok(scene)
 }
 
-/// The lighting of a glTF file opened on its own, said in one line: the grey sky
-/// `gltf_scene` adds, replaced by `--env`, or removed by `--no-default-env` (leaving the
-/// file's emissive materials, warned about when there are none).
+/// The lighting of a glTF file opened on its own, said in one line: its punctual lights
+/// (then `gltf_scene` adds no sky), or the grey sky `gltf_scene` adds; `--env` replaces the
+/// sky, `--no-default-env` removes it (leaving the file's emissive materials, warned about
+/// when there are none).
 fn choose_gltf_lighting(scene: &mut Scene, args: &SceneArgs) {
     let emitters = scene
         .materials
         .iter()
         .filter(|m| m.emission.max_element() > 0.0)
         .count();
-    let own = match emitters {
-        1 => "the file's emissive material".to_string(),
-        n => format!("the file's {n} emissive materials"),
+    let counted = |n: usize, what: &str| match n {
+        0 => None,
+        1 => Some(what.to_string()),
+        n => Some(format!("{n} {what}s")),
     };
-    let also = if emitters == 0 {
+    let own = [
+        counted(scene.lights.len(), "punctual light"),
+        counted(emitters, "emissive material"),
+    ]
+    .into_iter()
+    .flatten()
+    .enumerate()
+    .map(|(i, what)| format!("{} {what}", if i == 0 { "the file's" } else { "its" }))
+    .collect::<Vec<_>>()
+    .join(" and ");
+    let also = if own.is_empty() {
         String::new()
     } else {
         format!(" and {own}")
     };
     if args.env.is_some() {
         note!("lighting: the --env map{also}");
+    } else if !scene.lights.is_empty() {
+        note!(
+            "lighting: {own}, no sky (the file places lights of its own; --env FILE adds a \
+             map)"
+        );
     } else if args.no_default_env {
         scene.environment = Environment::Constant(Vec3::ZERO);
         if emitters == 0 {
@@ -98,8 +115,9 @@ fn choose_gltf_lighting(scene: &mut Scene, args: &SceneArgs) {
         }
     } else {
         note!(
-            "lighting: a uniform grey sky of radiance {GREY_SKY}{also} (glTF lights are not \
-             read; --env FILE lights it with a map, --no-default-env with its emitters alone)"
+            "lighting: a uniform grey sky of radiance {GREY_SKY}{also} (the file places no \
+             lights; --env FILE lights it with a map, --no-default-env with its emitters \
+             alone)"
         );
     }
 }

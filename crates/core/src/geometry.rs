@@ -131,6 +131,27 @@ impl Geometry {
         [0, 1, 2].map(|k| Vec3::from(self.vertices[i + k].position))
     }
 
+    /// Radius of the sphere around the box that holds every primitive (0 without any): how
+    /// far a sun's light reaches across the scene.
+    pub fn bounding_radius(&self) -> f32 {
+        let root = &self.nodes[0];
+        let (mut lo, mut hi) = (Vec3::MAX, Vec3::MIN);
+        for lane in 0..4 {
+            let (l, h) = (
+                Vec3::new(root.lo_x[lane], root.lo_y[lane], root.lo_z[lane]),
+                Vec3::new(root.hi_x[lane], root.hi_y[lane], root.hi_z[lane]),
+            );
+            if l.cmple(h).all() {
+                (lo, hi) = (lo.min(l), hi.max(h));
+            }
+        }
+        if lo.cmple(hi).all() {
+            0.5 * (hi - lo).length()
+        } else {
+            0.0
+        }
+    }
+
     /// Number of triangles in the scene.
     pub fn triangle_count(&self) -> usize {
         self.shapes.iter().map(|s| s.triangle_count as usize).sum()

@@ -68,6 +68,11 @@ const _: () = assert!(size_of::<GpuObject>() == 80);
 /// [`GpuLight::kind`] of an emissive quad, sphere or cylinder, or one triangle of an
 /// emissive mesh (`area_light.wgsl`).
 pub const LIGHT_AREA: u32 = 0;
+/// [`GpuLight::kind`] of a point or spot light (`point_light.wgsl`).
+pub const LIGHT_POINT: u32 = 1;
+/// [`GpuLight::kind`] of a sun: a directional light, or a small disk of the sky
+/// (`sun_light.wgsl`).
+pub const LIGHT_SUN: u32 = 2;
 
 /// One entry of the light table, chosen with probability proportional to its power: a light
 /// of type `kind` (a `LIGHT_*`; its file in the kernels samples it). WGSL: `Light`.
@@ -76,7 +81,8 @@ pub const LIGHT_AREA: u32 = 0;
 pub struct GpuLight {
     /// `LIGHT_*`.
     pub kind: u32,
-    /// [`LIGHT_AREA`]: index into the object buffer.
+    /// [`LIGHT_AREA`]: index into the object buffer; [`LIGHT_POINT`], [`LIGHT_SUN`]: the
+    /// first `vec4` of its parameter block (`crate::light_table`).
     pub index: u32,
     /// [`LIGHT_AREA`]: the triangle of a mesh, 0 for a whole shape.
     pub primitive: u32,

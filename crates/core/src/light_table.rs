@@ -1,15 +1,18 @@
-//! The light table: one entry per emissive quad, sphere and cylinder and one per triangle
-//! of an emissive mesh, each chosen with probability proportional to its power (area x
-//! luminance). Each emissive object points at its first entry, so that a path that hits it
-//! by BSDF sampling can compute the density of having sampled it (MIS).
+//! The light table: one entry per emissive quad, sphere and cylinder, one per triangle of
+//! an emissive mesh, and one per point, spot and sun light, each chosen with probability
+//! proportional to its power. Each emissive object points at its first entry, so that a
+//! path that hits it by BSDF sampling can compute the density of having sampled it (MIS).
+//! A point or sun light's parameters are a block of `vec4`s in the parameter-block buffer
+//! (after the materials'), which its entry's `index` points at.
 
 use bytemuck::Zeroable;
 use glam::Vec3;
+use pathlight_scene::{Light, LightKind};
 
 use crate::geometry::Geometry;
 use crate::gpu_types::{
     FLAG_CAPS, GpuLight, GpuObject, GpuVertex, KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE,
-    LIGHT_AREA, NO_LIGHT,
+    LIGHT_AREA, LIGHT_POINT, LIGHT_SUN, NO_LIGHT,
 };
 
 /// Luminance of linear RGB (Rec. 709 weights): what emitters and environment-map cells are
@@ -44,21 +47,36 @@ pub fn emitter_area(object: &GpuObject, vertices: &[GpuVertex], primitive: u32) 
     }
 }
 
-/// The light table of `objects` (with their materials set) in `geometry`, never empty (a
-/// placeholder when nothing emits), and the number of real entries; `emission` is each
-/// material's mean emitted radiance. Sets each object's `light` to its first entry, or
-/// [`NO_LIGHT`].
+/// The weight an emitter of `rgb` is chosen by: its luminance, or a thousandth of its
+/// largest channel when that is more (so a light of a colour with no luminance is chosen).
+fn weight(rgb: Vec3) -> f32 {
+    luminance(rgb).max(rgb.max_element() * 1e-3)
+}
+
+/// The light table of `objects` (with their materials set) in `geometry` and of `lights`,
+/// never empty (a placeholder when nothing emits), and the number of real entries;
+/// `emission` is each material's mean emitted radiance. Sets each object's `light` to its
+/// first entry, or [`NO_LIGHT`], and appends the lights' parameter blocks to `blocks`.
+///
+/// Entries are chosen in groups: all emissive surfaces are one group, each point, spot and
+/// sun light another; half the choices go by the groups' power, half evenly to each group
+/// (a spot light's power is small beside a sun's, yet it is all the light where it points),
+/// and an entry within its group by power. An entry's power, divided by pi: an area
+/// light's area times its radiance (its luminance); a point light's 4 pi I / pi; a spot
+/// light's 2 pi I (1 - (cos_inner + cos_outer) / 2) / pi (its cone's, as pbrt estimates
+/// it); a sun's irradiance times the area of the disk the scene's bounding sphere shows it.
 pub fn build(
     objects: &mut [GpuObject],
     emission: &[Vec3],
     geometry: &Geometry,
+    lights: &[Light],
+    blocks: &mut Vec<[f32; 4]>,
 ) -> (Vec<GpuLight>, u32) {
-    let mut lights = Vec::new();
+    let mut table = Vec::new();
     let mut powers = Vec::new();
     for (i, object) in objects.iter_mut().enumerate() {
         object.light = NO_LIGHT;
-        let e = emission[object.material as usize];
-        let luminance = luminance(e).max(e.max_element() * 1e-3);
+        let luminance = weight(emission[object.material as usize]);
         if luminance <= 0.0 {
             continue;
         }
@@ -67,10 +85,10 @@ pub fn build(
         } else {
             0..1
         };
-        object.light = lights.len() as u32;
+        object.light = table.len() as u32;
         for primitive in primitives {
             powers.push(emitter_area(object, &geometry.vertices, primitive) * luminance);
-            lights.push(GpuLight {
+            table.push(GpuLight {
                 kind: LIGHT_AREA,
                 index: i as u32,
                 primitive,
@@ -79,26 +97,129 @@ pub fn build(
             });
         }
     }
-    let total: f64 = powers.iter().map(|&p| f64::from(p)).sum();
+    let scene_radius = geometry.bounding_radius();
+    for light in lights.iter().filter(|l| !l.is_dark()) {
+        let (kind, power, block) = punctual(light, scene_radius);
+        powers.push(power);
+        table.push(GpuLight {
+            kind,
+            index: blocks.len() as u32,
+            primitive: 0,
+            cdf: 0.0,
+            pmf: 0.0,
+        });
+        blocks.extend(block);
+    }
+    // Groups: every emissive surface together (group 0, when there are any), then each
+    // point and sun light alone.
+    let surfaces = table.len();
+    let group = |entry: usize| {
+        if entry < surfaces {
+            0
+        } else {
+            entry - surfaces + usize::from(surfaces > 0)
+        }
+    };
+    let groups = table.len() - surfaces + usize::from(surfaces > 0);
+    let mut group_power = vec![0.0f64; groups];
+    for (entry, &power) in powers.iter().enumerate() {
+        group_power[group(entry)] += f64::from(power);
+    }
+    let total: f64 = group_power.iter().sum();
     if total <= 0.0 || !total.is_finite() {
         // Only zero-area emitters: nothing can be sampled (or hit).
-        lights.clear();
+        table.clear();
         objects.iter_mut().for_each(|o| o.light = NO_LIGHT);
     }
+    let share = |g: usize| {
+        if groups == 1 {
+            1.0
+        } else {
+            0.5 * group_power[g] / total + 0.5 / groups as f64
+        }
+    };
     let mut running = 0.0f64;
-    for (light, power) in lights.iter_mut().zip(&powers) {
-        running += f64::from(*power);
-        light.pmf = (f64::from(*power) / total) as f32;
-        light.cdf = (running / total) as f32;
+    for (entry, (light, power)) in table.iter_mut().zip(&powers).enumerate() {
+        let g = group(entry);
+        let pmf = if group_power[g] > 0.0 {
+            share(g) * f64::from(*power) / group_power[g]
+        } else {
+            0.0
+        };
+        running += pmf;
+        light.pmf = pmf as f32;
+        light.cdf = running as f32;
     }
-    if let Some(last) = lights.last_mut() {
+    if let Some(last) = table.last_mut() {
         last.cdf = 1.0;
     }
-    let count = lights.len() as u32;
-    if lights.is_empty() {
-        lights.push(GpuLight::zeroed());
+    let count = table.len() as u32;
+    if table.is_empty() {
+        table.push(GpuLight::zeroed());
     }
-    (lights, count)
+    (table, count)
+}
+
+/// A point or sun light's `LIGHT_*`, power (over pi) and parameter block. A point or spot
+/// light: `[position, radius]`, `[intensity, the spot's falloff scale]`, `[axis, cos of the
+/// outer angle]` (a point light's cone takes in every direction); a sun: `[unit direction
+/// towards it, 1 - cos of its disk's half-angle]`, `[irradiance, its disk's radiance over
+/// its irradiance]` (both 0 for a true directional light).
+fn punctual(light: &Light, scene_radius: f32) -> (u32, f32, Vec<[f32; 4]>) {
+    let i = light.intensity;
+    match light.kind {
+        LightKind::Point {
+            position,
+            radius,
+            cone,
+        } => {
+            let (axis, cos_inner, cos_outer, power) = match cone {
+                None => (Vec3::Z, -2.0, -2.0, 4.0 * weight(i)),
+                Some(c) => {
+                    let (cos_inner, cos_outer) = (
+                        c.inner_deg.to_radians().cos(),
+                        c.outer_deg.to_radians().cos(),
+                    );
+                    let power = 2.0 * weight(i) * (1.0 - 0.5 * (cos_inner + cos_outer));
+                    (c.axis, cos_inner, cos_outer, power)
+                }
+            };
+            let block = vec![
+                position.extend(radius).to_array(),
+                i.extend(spot_scale(cos_inner, cos_outer)).to_array(),
+                axis.extend(cos_outer).to_array(),
+            ];
+            (LIGHT_POINT, power, block)
+        }
+        LightKind::Sun {
+            direction,
+            angular_diameter_deg,
+        } => {
+            let half = 0.5 * angular_diameter_deg.to_radians();
+            let sin2 = half.sin() * half.sin();
+            let per_irradiance = if sin2 > 0.0 {
+                1.0 / (std::f32::consts::PI * sin2)
+            } else {
+                0.0
+            };
+            let block = vec![
+                // 1 - cos(half), exact for the real sun's 0.27 degrees.
+                (-direction)
+                    .extend(2.0 * (0.5 * half).sin().powi(2))
+                    .to_array(),
+                i.extend(per_irradiance).to_array(),
+            ];
+            (LIGHT_SUN, weight(i) * scene_radius * scene_radius, block)
+        }
+    }
+}
+
+/// The factor of a spot light's linear step from `cos_outer` to `cos_inner`
+/// (`1 / (cos_inner - cos_outer)`), or a huge finite one for a hard edge (equal angles),
+/// so that the step takes no branch.
+fn spot_scale(cos_inner: f32, cos_outer: f32) -> f32 {
+    let width = cos_inner - cos_outer;
+    if width > 1e-20 { 1.0 / width } else { 1e30 }
 }
 
 #[cfg(test)]

@@ -26,8 +26,9 @@ pub struct Shading {
     pub object_count: u32,
     /// Materials' common parts ([`PackedMaterials::materials`]). Never empty.
     pub materials: Vec<GpuMaterial>,
-    /// Their models' parameter blocks ([`PackedMaterials::params`]).
-    pub material_params: Vec<[f32; 4]>,
+    /// The parameter blocks: the materials' models' ([`PackedMaterials::params`]), then the
+    /// point and sun lights' ([`light_table::build`]).
+    pub param_blocks: Vec<[f32; 4]>,
     /// Their texture slots ([`PackedMaterials::texture_slots`]). Never empty.
     pub texture_slots: Vec<GpuTextureSlot>,
     /// The light table ([`light_table::build`]). Never empty.
@@ -59,7 +60,7 @@ impl Shading {
     pub fn build(scene: &Scene, geometry: &Geometry, textures: &Textures) -> Self {
         let PackedMaterials {
             materials,
-            params: material_params,
+            params: mut param_blocks,
             texture_slots,
         } = PackedMaterials::build(&scene.materials, textures);
         let mut objects: Vec<GpuObject> = geometry
@@ -82,7 +83,13 @@ impl Shading {
             .iter()
             .map(|m| mean_emission(m, &scene.textures))
             .collect();
-        let (lights, light_count) = light_table::build(&mut objects, &emission, geometry);
+        let (lights, light_count) = light_table::build(
+            &mut objects,
+            &emission,
+            geometry,
+            &scene.lights,
+            &mut param_blocks,
+        );
         let object_count = objects.len() as u32;
         if objects.is_empty() {
             objects.push(GpuObject::zeroed());
@@ -91,7 +98,7 @@ impl Shading {
             objects,
             object_count,
             materials,
-            material_params,
+            param_blocks,
             texture_slots,
             lights,
             light_count,

@@ -93,7 +93,7 @@ impl Fingerprint {
             bytemuck::cast_slice(&textures.texels),
             bytemuck::cast_slice(&shading.objects),
             bytemuck::cast_slice(&shading.materials),
-            bytemuck::cast_slice(&shading.material_params),
+            bytemuck::cast_slice(&shading.param_blocks),
             bytemuck::cast_slice(&shading.texture_slots),
             bytemuck::cast_slice(&shading.lights),
             bytemuck::cast_slice(&counts),

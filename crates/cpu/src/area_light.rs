@@ -16,7 +16,7 @@ use crate::cpu_scene::CpuScene;
 use crate::intersect::{MISS, Ray, intersect_sphere};
 use crate::light_sample::{INVALID, LightSample};
 use crate::material::emission_at;
-use crate::sampling::{Frame, sample_disk, sample_uniform_sphere, sin_cos_turns};
+use crate::sampling::{Frame, sample_cone, sample_disk, sample_uniform_sphere, sin_cos_turns};
 use crate::textures::triangle_uv;
 
 /// The area of light-table entry `(object, primitive)` (`o` is its object): the whole
@@ -32,7 +32,8 @@ fn emitter_area(scene: &CpuScene, object: u32, o: &GpuObject, primitive: u32) ->
 
 /// `1 - cos` of the half-angle of the cone a sphere subtends from `p`, or a negative value
 /// when `p` is inside it. Twin of WGSL `sphere_cone`.
-fn sphere_cone(center: Vec3A, radius: f32, p: Vec3A) -> f32 {
+#[inline(always)]
+pub fn sphere_cone(center: Vec3A, radius: f32, p: Vec3A) -> f32 {
     let d2 = (center - p).length_squared();
     let r2 = radius * radius;
     if d2 <= r2 * 1.0001 {
@@ -101,14 +102,7 @@ fn sample_shape(
             let radius = o.a[3];
             let one_minus_cos = sphere_cone(a, radius, p);
             if one_minus_cos > 0.0 {
-                let cos_theta = 1.0 - u.x * one_minus_cos;
-                let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-                let (sin, cos) = sin_cos_turns(u.y);
-                let dir = Frame::around((a - p).normalize()).to_world(Vec3A::new(
-                    sin_theta * cos,
-                    sin_theta * sin,
-                    cos_theta,
-                ));
+                let dir = sample_cone((a - p).normalize(), one_minus_cos, u);
                 let mut t = intersect_sphere(a.into(), radius, &Ray::new(p, dir), 1e30);
                 if t == MISS {
                     t = (a - p).dot(dir);
@@ -204,5 +198,6 @@ pub fn sample_area_light(
         radiance,
         pdf,
         valid: pdf > 0.0 && pdf.is_finite(),
+        mis: true,
     }
 }

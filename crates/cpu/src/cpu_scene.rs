@@ -24,9 +24,9 @@ pub struct CpuScene<'a> {
     pub objects: &'a [GpuObject],
     /// Materials' common parts (WGSL `materials`).
     pub materials: &'a [GpuMaterial],
-    /// Their models' parameter blocks (WGSL `material_params`).
-    pub material_params: &'a [[f32; 4]],
-    /// Their texture slots (WGSL `texture_slots`).
+    /// The materials' and the point and sun lights' parameter blocks (WGSL `param_blocks`).
+    pub param_blocks: &'a [[f32; 4]],
+    /// The materials' texture slots (WGSL `texture_slots`).
     pub texture_slots: &'a [GpuTextureSlot],
     /// The light table (WGSL `lights`).
     pub lights: &'a [GpuLight],
@@ -62,7 +62,7 @@ impl<'a> CpuScene<'a> {
             vertices: &scene.geometry.vertices,
             objects,
             materials: &scene.shading.materials,
-            material_params: &scene.shading.material_params,
+            param_blocks: &scene.shading.param_blocks,
             texture_slots: &scene.shading.texture_slots,
             lights: &scene.shading.lights,
             texels: &scene.textures.texels,

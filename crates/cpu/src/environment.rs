@@ -241,6 +241,7 @@ pub fn sample_environment(
             radiance: env_radiance(scene, params, wi),
             pdf,
             valid: pdf > 0.0 && pdf.is_finite(),
+            mis: true,
         };
     }
     let wi = Frame::around(n).to_world(sample_cosine_hemisphere(u));
@@ -253,6 +254,7 @@ pub fn sample_environment(
         radiance,
         pdf,
         valid: pdf > 0.0,
+        mis: true,
     }
 }
 

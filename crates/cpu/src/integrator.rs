@@ -222,9 +222,12 @@ impl Path {
                 if e.f.max_element() > 0.0 {
                     self.sample.rays += 1;
                     let (ray, t_max) = shadow_ray(s.position, s.ng, &ls);
-                    let radiance =
-                        self.throughput * e.f * ls.radiance * power_heuristic(ls.pdf, e.pdf)
-                            / ls.pdf;
+                    let weight = if ls.mis {
+                        power_heuristic(ls.pdf, e.pdf)
+                    } else {
+                        1.0
+                    };
+                    let radiance = self.throughput * e.f * ls.radiance * weight / ls.pdf;
                     shadow = Some(ShadowTest {
                         ray,
                         t_max,

@@ -1,6 +1,6 @@
 //! What every light type's sampling returns: a direction towards the light, the point it
-//! reaches (for a finite light), the radiance arriving and the density of having sampled
-//! it. Twin of `light_sample.wgsl`.
+//! reaches (for a finite light), the radiance arriving, the density of having sampled it
+//! and whether BSDF sampling could have found it too. Twin of `light_sample.wgsl`.
 
 use glam::Vec3A;
 
@@ -19,6 +19,10 @@ pub struct LightSample {
     pub pdf: f32,
     /// False when the sample cannot contribute (back side, zero density).
     pub valid: bool,
+    /// Whether a ray can hit the light too, so that the sample is weighted against BSDF
+    /// sampling (multiple importance sampling); false for point and sun lights, which
+    /// only light samples reach.
+    pub mis: bool,
 }
 
 /// No sample. Twin of WGSL `invalid_light_sample`.
@@ -29,4 +33,5 @@ pub const INVALID: LightSample = LightSample {
     radiance: Vec3A::ZERO,
     pdf: 0.0,
     valid: false,
+    mis: true,
 };

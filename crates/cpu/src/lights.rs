@@ -1,23 +1,26 @@
 //! Next-event estimation: choosing a light and a point on it, and the density of doing so,
 //! with the one dispatch on the light type. The environment ([`crate::environment`]) is
 //! chosen first, with probability `env_pmf`; otherwise an entry of the light table by power,
-//! sampled by its type's module: `LIGHT_AREA`, [`crate::area_light`] (each `match` on the
-//! type has one arm per type; with one type, a single arm). Twin of `lights.wgsl`.
+//! sampled by its type's module: `LIGHT_AREA`, [`crate::area_light`]; `LIGHT_POINT`,
+//! [`crate::point_light`]; `LIGHT_SUN`, [`crate::sun_light`]. Only area lights can be hit
+//! by a ray, so only they have a density for [`light_pdf`]. Twin of `lights.wgsl`.
 
 use glam::{Vec2, Vec3A};
-use pathlight_core::gpu_types::{GpuRenderParams, KIND_MESH};
+use pathlight_core::gpu_types::{GpuRenderParams, KIND_MESH, LIGHT_POINT, LIGHT_SUN};
 
 use crate::area_light::{area_light_pdf, sample_area_light};
 use crate::cpu_scene::CpuScene;
 use crate::environment::sample_environment;
 use crate::light_sample::{INVALID, LightSample};
+use crate::point_light::sample_point_light;
 use crate::sampling::first_above;
+use crate::sun_light::sample_sun_light;
 
 /// Density (solid angle, including the choice of the light) with which [`sample_light`]
 /// from `p` gives point `p_light` (normal `n_light`) of the emitter a ray hit: triangle
-/// `primitive` of `object` (or the whole shape). Twin of WGSL `light_pdf`.
+/// `primitive` of `object` (or the whole shape): an area light's, the only kind a ray hits.
+/// Twin of WGSL `light_pdf`.
 #[inline(always)]
-#[expect(clippy::match_single_binding, reason = "one arm per light type")]
 pub fn light_pdf(
     scene: &CpuScene,
     params: &GpuRenderParams,
@@ -33,17 +36,13 @@ pub fn light_pdf(
     } else {
         o.light
     };
-    let light = &scene.lights[entry as usize];
-    let pmf = light.pmf * (1.0 - params.env_pmf);
-    match light.kind {
-        _ => area_light_pdf(scene, o, object, primitive, pmf, p, p_light, n_light),
-    }
+    let pmf = scene.lights[entry as usize].pmf * (1.0 - params.env_pmf);
+    area_light_pdf(scene, o, object, primitive, pmf, p, p_light, n_light)
 }
 
 /// A light and a point on it as seen from `p` with normal `n` (on the side light is
 /// gathered from): `u_select` chooses the light, `u` the point. Twin of WGSL `sample_light`.
 #[inline(always)]
-#[expect(clippy::match_single_binding, reason = "one arm per light type")]
 pub fn sample_light(
     scene: &CpuScene,
     params: &GpuRenderParams,
@@ -69,6 +68,8 @@ pub fn sample_light(
     let u_part = ((u_light - below) / light.pmf.max(1e-30)).clamp(0.0, 1.0);
     let pmf = light.pmf * (1.0 - params.env_pmf);
     match light.kind {
+        LIGHT_POINT => sample_point_light(scene, light.index, pmf, p, u),
+        LIGHT_SUN => sample_sun_light(scene, light.index, pmf, u),
         _ => sample_area_light(scene, light.index, light.primitive, pmf, p, u, u_part),
     }
 }

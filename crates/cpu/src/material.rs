@@ -40,7 +40,7 @@ pub struct MaterialPoint {
 pub fn material_at(scene: &CpuScene, index: u32, uv: Vec2) -> MaterialPoint {
     let m = &scene.materials[index as usize];
     let first = m.params as usize;
-    let block = &scene.material_params[first..first + MODEL_PARAMS];
+    let block = &scene.param_blocks[first..first + MODEL_PARAMS];
     let mut params = [
         Vec4::from_array(block[0]),
         Vec4::from_array(block[1]),

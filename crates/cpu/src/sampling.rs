@@ -159,6 +159,17 @@ pub fn sample_uniform_sphere(u: Vec2) -> Vec3A {
     Vec3A::new(r * cos, r * sin, z)
 }
 
+/// Uniform direction within the cone about unit `axis` whose half-angle's cosine is
+/// `1 - one_minus_cos` (given as `1 - cos`, exact for the small cones of the sun and far
+/// spheres); its density is `1 / (2 pi one_minus_cos)`. Twin of WGSL `sample_cone`.
+#[inline(always)]
+pub fn sample_cone(axis: Vec3A, one_minus_cos: f32, u: Vec2) -> Vec3A {
+    let below = u.x * one_minus_cos;
+    let sin_theta = (below * (2.0 - below)).max(0.0).sqrt();
+    let (sin, cos) = sin_cos_turns(u.y);
+    Frame::around(axis).to_world(Vec3A::new(sin_theta * cos, sin_theta * sin, 1.0 - below))
+}
+
 /// Uniform point on the unit disk (polar). Twin of WGSL `sample_disk`.
 pub fn sample_disk(u: Vec2) -> Vec2 {
     let r = u.x.sqrt();

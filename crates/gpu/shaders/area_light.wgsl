@@ -95,10 +95,7 @@ fn sample_shape(o: Object, primitive: u32, p: vec3f, u: vec2f, u_part: f32) -> S
             let radius = o.a.w;
             let one_minus_cos = sphere_cone(a, radius, p);
             if one_minus_cos > 0.0 {
-                let cos_theta = 1.0 - u.x * one_minus_cos;
-                let sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
-                let phi = TAU * u.y;
-                let dir = frame_around(normalize(a - p)) * vec3f(sin_theta * cos(phi), sin_theta * sin(phi), cos_theta);
+                let dir = sample_cone(normalize(a - p), one_minus_cos, u);
                 var t = intersect_sphere(a, radius, Ray(p, dir), 1e30);
                 if t == MISS {
                     t = dot(a - p, dir);
@@ -167,5 +164,5 @@ fn sample_area_light(object: u32, primitive: u32, pmf: f32, p: vec3f, u: vec2f, 
     if o.kind == KIND_MESH {
         radiance = emission_at(o.material, triangle_uv(primitive, ss.barycentrics.x, ss.barycentrics.y));
     }
-    return LightSample(wi, ss.point, true, radiance, pdf, pdf > 0.0 && pdf <= 3.0e38);
+    return LightSample(wi, ss.point, true, radiance, pdf, pdf > 0.0 && pdf <= 3.0e38, true);
 }

@@ -208,9 +208,9 @@ fn sample_environment(n: vec3f, u: vec2f) -> LightSample {
     if has_env_map() {
         let es = sample_env_map(u);
         let pdf = params.env_pmf * es.pdf;
-        return LightSample(es.wi, vec3f(0.0), false, env_radiance(es.wi), pdf, pdf > 0.0 && pdf <= 3.0e38);
+        return LightSample(es.wi, vec3f(0.0), false, env_radiance(es.wi), pdf, pdf > 0.0 && pdf <= 3.0e38, true);
     }
     let wi = frame_around(n) * sample_cosine_hemisphere(u);
     let pdf = env_pdf(n, wi);
-    return LightSample(wi, vec3f(0.0), false, params.environment, pdf, pdf > 0.0);
+    return LightSample(wi, vec3f(0.0), false, params.environment, pdf, pdf > 0.0, true);
 }

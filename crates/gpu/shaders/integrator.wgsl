@@ -207,7 +207,7 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> PathResult {
                 let e = eval_material(material, s, wo, ls.wi);
                 if max(max(e.f.x, e.f.y), e.f.z) > 0.0 {
                     shadow = shadow_ray(s.position, s.ng, ls);
-                    shadow_radiance = throughput * e.f * ls.radiance * power_heuristic(ls.pdf, e.pdf) / ls.pdf;
+                    shadow_radiance = throughput * e.f * ls.radiance * select(1.0, power_heuristic(ls.pdf, e.pdf), ls.mis) / ls.pdf;
                     shadow_pending = true;
                 }
             }

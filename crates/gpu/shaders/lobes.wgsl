@@ -10,7 +10,7 @@
 #import sampling
 #import microfacet
 
-// The model's parameters: its block in `material_params`, laid out by
+// The model's parameters: its block in `param_blocks`, laid out by
 // `pathlight_core::materials` (`lobes_block`).
 // CPU twin: `LobesParams`.
 struct LobesParams {

@@ -33,7 +33,7 @@ fn material_at(index: u32, uv: vec2f) -> MaterialPoint {
     let m = materials[index];
     // Loaded with constant indices (MODEL_PARAMS of them): an array indexed at run time
     // would be kept in memory rather than in registers.
-    var params = array<vec4f, MODEL_PARAMS>(material_params[m.params], material_params[m.params + 1u], material_params[m.params + 2u], material_params[m.params + 3u]);
+    var params = array<vec4f, MODEL_PARAMS>(param_blocks[m.params], param_blocks[m.params + 1u], param_blocks[m.params + 2u], param_blocks[m.params + 3u]);
     var base_color = m.base_color;
     if has_texture(m, TEXTURE_BASE) {
         base_color = m.base_color * srgb_to_linear(material_texture(m, TEXTURE_BASE, uv).rgb);

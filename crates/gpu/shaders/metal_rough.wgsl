@@ -9,7 +9,7 @@
 #import sampling
 #import microfacet
 
-// The model's parameters: its block in `material_params`, laid out by
+// The model's parameters: its block in `param_blocks`, laid out by
 // `pathlight_core::materials` (`metal_rough_block`), with its texture applied.
 // CPU twin: `MetalRoughParams`.
 struct MetalRoughParams {

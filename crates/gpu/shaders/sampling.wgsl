@@ -32,6 +32,17 @@ fn sample_uniform_sphere(u: vec2f) -> vec3f {
     return vec3f(r * cos(phi), r * sin(phi), z);
 }
 
+// Uniform direction within the cone about unit `axis` whose half-angle's cosine is
+// 1 - one_minus_cos (given as 1 - cos, exact for small cones); density
+// 1 / (2 pi one_minus_cos).
+// CPU twin: `sample_cone`.
+fn sample_cone(axis: vec3f, one_minus_cos: f32, u: vec2f) -> vec3f {
+    let below = u.x * one_minus_cos;
+    let sin_theta = sqrt(max(0.0, below * (2.0 - below)));
+    let phi = TAU * u.y;
+    return frame_around(axis) * vec3f(sin_theta * cos(phi), sin_theta * sin(phi), 1.0 - below);
+}
+
 // Uniform point on the unit disk (polar).
 // CPU twin: `sample_disk`.
 fn sample_disk(u: vec2f) -> vec2f {

@@ -110,7 +110,7 @@ struct TextureSlot {
 }
 
 // A material's common part in linear RGB: its model (MODEL_* of material.wgsl) reads its
-// parameter block from `material_params[params]` on; its texture TEXTURE_* is
+// parameter block from `param_blocks[params]` on; its texture TEXTURE_* is
 // `texture_slots[textures + TEXTURE_*]`, present when that bit of `texture_mask` is set.
 // Host: `GpuMaterial`.
 struct Material {
@@ -139,5 +139,6 @@ struct Material {
 @group(0) @binding(7) var<storage, read> primitives: array<Primitive>;
 // Per BVH node, its parent's index << 2 | its lane there (`pathlight_core::bvh::parents`).
 @group(0) @binding(8) var<storage, read> parents: array<u32>;
-// The materials' parameter blocks (`pathlight_core::materials`).
-@group(0) @binding(11) var<storage, read> material_params: array<vec4f>;
+// The parameter blocks: the materials' (`pathlight_core::materials`), then the point and
+// sun lights' (`pathlight_core::light_table`).
+@group(0) @binding(11) var<storage, read> param_blocks: array<vec4f>;

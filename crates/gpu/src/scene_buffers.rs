@@ -100,7 +100,7 @@ fn environment_contents(environment: &EnvironmentData) -> [(usize, &'static str,
 }
 
 /// The shading buffers: bindings 1 (objects), 3 (materials), 4 (texture slots), 6
-/// (lights) and 11 (material parameters).
+/// (lights) and 11 (parameter blocks).
 fn shading_contents(shading: &Shading) -> [(usize, &'static str, &[u8]); 5] {
     [
         (1, "objects", bytemuck::cast_slice(&shading.objects)),
@@ -113,8 +113,8 @@ fn shading_contents(shading: &Shading) -> [(usize, &'static str, &[u8]); 5] {
         (6, "lights", bytemuck::cast_slice(&shading.lights)),
         (
             11,
-            "material parameters",
-            bytemuck::cast_slice(&shading.material_params),
+            "parameter blocks",
+            bytemuck::cast_slice(&shading.param_blocks),
         ),
     ]
 }

@@ -42,9 +42,62 @@ pub struct SceneDesc {
     /// Surfaces of revolution of a profile curve.
     #[serde(default)]
     pub revolve: Vec<Spanned<RevolveDesc>>,
-    /// glTF 2.0 files placed in the scene with their own materials.
+    /// glTF 2.0 files placed in the scene with their own materials and punctual lights.
     #[serde(default)]
     pub gltf: Vec<Spanned<GltfDesc>>,
+    /// Point, spot and sun lights.
+    #[serde(default)]
+    pub light: Vec<Spanned<LightDesc>>,
+}
+
+/// A point, spot or sun light (`docs/scene-format.md`, "Lights"): the loader checks which
+/// keys its `type` takes.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightDesc {
+    /// Optional name.
+    pub name: Option<String>,
+    /// `"point"`, `"spot"` or `"sun"`.
+    #[serde(rename = "type")]
+    pub kind: LightType,
+    /// Colour, in the file's `color_space`; white when absent.
+    #[serde(default = "white", deserialize_with = "exact::array")]
+    pub color: [f32; 3],
+    /// Point and spot: radiant intensity in W/sr; sun: irradiance in W/m^2 (times `color`).
+    pub intensity: f32,
+    /// Point and spot: position.
+    #[serde(default, deserialize_with = "exact::optional_array")]
+    pub position: Option<[f32; 3]>,
+    /// Spot and sun: the direction the light travels (a spot's may be `look_at` instead).
+    #[serde(default, deserialize_with = "exact::optional_array")]
+    pub direction: Option<[f32; 3]>,
+    /// Spot: a point on its axis (instead of `direction`).
+    #[serde(default, deserialize_with = "exact::optional_array")]
+    pub look_at: Option<[f32; 3]>,
+    /// Point and spot: radius of the small sphere the light is spread over (default 0).
+    pub radius: Option<f32>,
+    /// Spot: half-angle of full intensity, degrees (default 0).
+    pub inner_angle: Option<f32>,
+    /// Spot: half-angle where the light ends, degrees (default 45).
+    pub outer_angle: Option<f32>,
+    /// Sun: angular diameter of its disk, degrees (default 0, a true directional light).
+    pub angular_diameter: Option<f32>,
+}
+
+/// A light's `type`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LightType {
+    /// Shines in every direction from a point.
+    Point,
+    /// Shines within a cone from a point.
+    Spot,
+    /// Shines along one direction from infinitely far away.
+    Sun,
+}
+
+fn white() -> [f32; 3] {
+    [1.0, 1.0, 1.0]
 }
 
 /// A glTF 2.0 file (`.gltf` or `.glb`) placed in the scene: the triangles of its default

@@ -9,6 +9,7 @@ pub mod environment;
 pub mod error;
 mod exact;
 pub mod gltf_file;
+pub mod light;
 pub mod load;
 pub mod material;
 pub mod mesh;
@@ -24,6 +25,7 @@ pub use camera::Camera;
 pub use environment::{Environment, EnvironmentMap, HdrImage};
 pub use error::{RangeError, SceneError};
 pub use gltf_file::{GREY_SKY, GltfModel, gltf_scene, load_gltf};
+pub use light::{Cone, Light, LightKind};
 pub use load::{SceneSource, load_scene, load_scene_file};
 pub use material::{AlphaMode, Conductor, Lobes, Material, MetalRough, Model, TextureRef, Wrap};
 pub use settings::{RenderSettings, Sampler};
@@ -46,4 +48,6 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     /// Objects.
     pub objects: Vec<Object>,
+    /// Point, spot and sun lights.
+    pub lights: Vec<Light>,
 }

@@ -40,6 +40,7 @@ pub fn scene_of(objects: Vec<Object>) -> Scene {
         )],
         textures: Vec::new(),
         objects,
+        lights: Vec::new(),
     }
 }
 

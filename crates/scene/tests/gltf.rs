@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use base64::Engine;
 use glam::{Mat4, Quat, Vec3};
 use pathlight_scene::{
-    AlphaMode, Environment, Model, Scene, SceneSource, Shape, TriangleMesh, gltf_scene, load_gltf,
-    load_scene,
+    AlphaMode, Environment, LightKind, Model, Scene, SceneSource, Shape, TriangleMesh, gltf_scene,
+    load_gltf, load_scene,
 };
 
 fn data(path: &str) -> PathBuf {
@@ -425,4 +425,87 @@ fn a_mesh_placed_many_times_lands_where_each_node_puts_it() {
             assert!(g.distance(*e) < 1e-5, "{}: {g} vs {e}", object.name);
         }
     }
+}
+
+#[test]
+fn punctual_lights_are_placed_by_their_nodes() {
+    let path = data("PunctualLights/lights.gltf");
+    let scene = gltf_scene(&path, None).unwrap();
+    // A file that places lights opens without the default sky.
+    assert_eq!(scene.environment, Environment::Constant(Vec3::ZERO));
+    let names: Vec<&str> = scene.lights.iter().map(|l| l.name.as_str()).collect();
+    assert_eq!(names, ["lights/lamp", "lights/spot", "lights/sun"]);
+    let [lamp, spot, sun] = [0, 1, 2].map(|i| &scene.lights[i]);
+    // Candela and lux read one to one as W/sr and W/m^2, times the colour.
+    assert_eq!(lamp.intensity, Vec3::new(1.0, 0.5, 0.25));
+    assert_eq!(
+        lamp.kind,
+        LightKind::Point {
+            position: Vec3::new(-1.5, 0.0, 0.5),
+            radius: 0.0,
+            cone: None
+        }
+    );
+    assert_eq!(spot.intensity, Vec3::splat(20.0));
+    let LightKind::Point {
+        position,
+        cone: Some(cone),
+        ..
+    } = spot.kind
+    else {
+        panic!("the spot light has no cone: {spot:?}")
+    };
+    assert_eq!(position, Vec3::new(1.5, 1.0, 1.0));
+    assert_eq!(cone.axis, Vec3::NEG_Z);
+    assert!((cone.inner_deg - 0.1f32.to_degrees()).abs() < 1e-4);
+    assert!((cone.outer_deg - 0.2f32.to_degrees()).abs() < 1e-4);
+    assert_eq!(sun.intensity, Vec3::splat(2.0));
+    let LightKind::Sun {
+        direction,
+        angular_diameter_deg,
+    } = sun.kind
+    else {
+        panic!("the sun is not a sun: {sun:?}")
+    };
+    assert!(direction.distance(Vec3::new(0.0, 0.866_025_4, -0.5)) < 1e-5);
+    assert_eq!(angular_diameter_deg, 0.0);
+    // Placed by a scene file, the lights move with the file's transform.
+    let text = format!(
+        "[camera]\nposition = [0, 0, 9]\nlook_at = [0, 0, 0]\nfov_y = 40\n\
+         [[gltf]]\nfile = {:?}\ntransform = {{ translate = [0, 0, 2], rotate = [0, 0, 90] }}\n",
+        path.display().to_string()
+    );
+    let placed = load_scene(&SceneSource {
+        name: "placed.toml".into(),
+        text: &text,
+        base_dir: PathBuf::new(),
+        embedded: &[],
+    })
+    .unwrap();
+    let LightKind::Point { position, .. } = placed.lights[0].kind else {
+        panic!("{:?}", placed.lights[0])
+    };
+    assert!(
+        position.distance(Vec3::new(0.0, -1.5, 2.5)) < 1e-5,
+        "{position}"
+    );
+}
+
+#[test]
+fn bad_punctual_lights_are_refused_naming_the_node() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = |from: &str, to: &str| {
+        let path = dir.path().join("bad.gltf");
+        let text = std::fs::read_to_string(data("PunctualLights/lights.gltf")).unwrap();
+        assert!(text.contains(from), "{from}");
+        std::fs::write(&path, text.replace(from, to)).unwrap();
+        gltf_scene(&path, None).unwrap_err().to_string()
+    };
+    let message = file(r#""innerConeAngle": 0.1"#, r#""innerConeAngle": 0.5"#);
+    assert!(
+        message.contains("node 2: light 1: cone angles 0.5 and 0.2"),
+        "{message}"
+    );
+    let message = file(r#""intensity": 1.0"#, r#""intensity": -3.0"#);
+    assert!(message.contains("node 1: light 0: colour"), "{message}");
 }

@@ -3,10 +3,11 @@
 
 use std::path::{Path, PathBuf};
 
+use glam::Vec3;
 use pathlight_scene::settings::{MAX_RESOLUTION, MAX_SPP};
 use pathlight_scene::{
-    Environment, Lobes, Model, Scene, SceneError, SceneSource, Shape, default_scene, load_scene,
-    load_scene_file,
+    Cone, Environment, LightKind, Lobes, Model, Scene, SceneError, SceneSource, Shape,
+    default_scene, load_scene, load_scene_file,
 };
 
 fn repo() -> PathBuf {
@@ -50,8 +51,8 @@ fn shipped_scenes_load() {
         }
     }
     assert_eq!(
-        found, 23,
-        "default + outdoor + eight reference scenes + 13 furnace rings"
+        found, 24,
+        "default + outdoor + nine reference scenes + 13 furnace rings"
     );
 }
 
@@ -444,4 +445,126 @@ fn bad_environments_and_lenses_are_refused_with_line_or_texel() {
     }
     let camera = lens("aperture_radius = 0.1").unwrap().camera;
     assert_eq!((camera.aperture_radius, camera.focus_distance), (0.1, 3.0));
+}
+
+#[test]
+fn lights_load_with_their_placement_and_units() {
+    let scene = load(
+        "[[light]]\ntype = \"point\"\nposition = [1, 2, 3]\ncolor = [1, 1, 0]\nintensity = 4\n\
+         [[light]]\nname = \"key\"\ntype = \"spot\"\nposition = [0, 2, 0]\nlook_at = [0, 0, 0]\n\
+         intensity = 10\ninner_angle = 10\nouter_angle = 30\nradius = 0.1\n\
+         [[light]]\ntype = \"sun\"\ndirection = [0, -2, 0]\nintensity = 3\nangular_diameter = 0.53\n",
+    )
+    .unwrap();
+    assert_eq!(scene.lights.len(), 3);
+    let [point, spot, sun] = [0, 1, 2].map(|i| &scene.lights[i]);
+    assert_eq!(point.name, "light0");
+    assert_eq!(point.intensity, Vec3::new(4.0, 4.0, 0.0));
+    assert_eq!(
+        point.kind,
+        LightKind::Point {
+            position: Vec3::new(1.0, 2.0, 3.0),
+            radius: 0.0,
+            cone: None
+        }
+    );
+    assert_eq!(spot.name, "key");
+    assert_eq!(
+        spot.kind,
+        LightKind::Point {
+            position: Vec3::new(0.0, 2.0, 0.0),
+            radius: 0.1,
+            cone: Some(Cone {
+                axis: Vec3::NEG_Y,
+                inner_deg: 10.0,
+                outer_deg: 30.0
+            })
+        }
+    );
+    assert_eq!(sun.intensity, Vec3::splat(3.0));
+    assert_eq!(
+        sun.kind,
+        LightKind::Sun {
+            direction: Vec3::NEG_Y,
+            angular_diameter_deg: 0.53
+        }
+    );
+    // sRGB colours are decoded as material colours are.
+    let srgb = load("[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\ncolor = [0.5, 0.5, 0.5]\nintensity = 1\n")
+        .unwrap();
+    assert!((srgb.lights[0].intensity.x - 0.214).abs() < 1e-3);
+}
+
+#[test]
+fn bad_lights_are_refused_with_line_and_key() {
+    for (body, wanted) in [
+        (
+            "[[light]]\ntype = \"lamp\"\nintensity = 1\n",
+            "unknown variant `lamp`",
+        ),
+        ("[[light]]\ntype = \"point\"\n", "missing field `intensity`"),
+        (
+            "[[light]]\ntype = \"point\"\nintensity = 1\n",
+            "test.toml:6: a point light needs light.position",
+        ),
+        (
+            "[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\nintensity = -1\n",
+            "test.toml:6: light.intensity = -1 must be finite and >= 0",
+        ),
+        (
+            "[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\nintensity = 1\ndirection = [0, -1, 0]\n",
+            "light.direction does not apply to a point light",
+        ),
+        (
+            "[[light]]\ntype = \"sun\"\nintensity = 1\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\n",
+            "light.position does not apply to a sun light",
+        ),
+        (
+            "[[light]]\ntype = \"sun\"\nintensity = 1\n",
+            "a sun light needs light.direction",
+        ),
+        (
+            "[[light]]\ntype = \"sun\"\nintensity = 1\ndirection = [0, 0, 0]\n",
+            "light.direction must not be zero",
+        ),
+        (
+            "[[light]]\ntype = \"sun\"\nintensity = 1\ndirection = [0, -1, 0]\nangular_diameter = 90\n",
+            "light.angular_diameter = 90 must lie in [0, 60] degrees",
+        ),
+        (
+            "[[light]]\ntype = \"spot\"\nintensity = 1\nposition = [0, 1, 0]\n",
+            "a spot light needs light.direction or light.look_at",
+        ),
+        (
+            "[[light]]\ntype = \"spot\"\nintensity = 1\nposition = [0, 1, 0]\nlook_at = [0, 1, 0]\n",
+            "light.look_at equals light.position",
+        ),
+        (
+            "[[light]]\ntype = \"spot\"\nintensity = 1\nposition = [0, 1, 0]\nlook_at = [0, 0, 0]\ndirection = [0, -1, 0]\n",
+            "takes one of light.direction and light.look_at",
+        ),
+        (
+            "[[light]]\ntype = \"spot\"\nintensity = 1\nposition = [0, 1, 0]\nlook_at = [0, 0, 0]\nouter_angle = 20\ninner_angle = 30\n",
+            "light.inner_angle = 30 must lie in [0, 20] degrees",
+        ),
+        (
+            "[[light]]\ntype = \"spot\"\nintensity = 1\nposition = [0, 1, 0]\nlook_at = [0, 0, 0]\nouter_angle = 0\n",
+            "light.outer_angle must be above 0",
+        ),
+        (
+            "[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\nintensity = 1\nradius = -1\n",
+            "radius",
+        ),
+        (
+            "[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\nintensity = 1\ncolor = [2, 1, 1]\n",
+            "sRGB colours lie in [0, 1]",
+        ),
+        (
+            "[[light]]\ntype = \"point\"\nposition = [0, 1e30, 0]\nintensity = 1\n",
+            "light.position",
+        ),
+    ] {
+        let message = error(body);
+        assert!(message.contains(wanted), "{body:?}: {message}");
+    }
 }

@@ -1,6 +1,7 @@
 //! glTF 2.0 import (`.gltf` with its buffers and images, `.glb`, `data:` URIs): the
 //! triangles of every node of the default scene in world space, their metal-rough
-//! materials and textures, and the scene's perspective cameras. Malformed files are refused
+//! materials and textures, the scene's perspective cameras and its punctual lights
+//! (`KHR_lights_punctual`). Malformed files are refused
 //! naming the element (mesh, primitive, accessor, buffer, image, node); points and lines
 //! are skipped with a warning.
 
@@ -17,7 +18,8 @@ use crate::desc::RenderDesc;
 use crate::error::SceneError;
 use crate::settings::MAX_COORDINATE;
 use crate::{
-    Camera, Environment, Material, Object, RenderSettings, Scene, Shape, Texture, TriangleMesh,
+    Camera, Cone, Environment, Light, LightKind, Material, Object, RenderSettings, Scene, Shape,
+    Texture, TriangleMesh,
 };
 use data::Files;
 use materials::Materials;
@@ -56,6 +58,9 @@ pub struct GltfModel {
     pub textures: Vec<Texture>,
     /// Perspective cameras in node order.
     pub cameras: Vec<GltfCamera>,
+    /// Punctual lights in node order, their candela and lux read as W/sr and W/m^2 (one to
+    /// one, as glTF viewers show them and as glTF emission is read).
+    pub lights: Vec<Light>,
 }
 
 impl GltfModel {
@@ -98,12 +103,6 @@ pub fn load_gltf(path: &Path, transform: Mat4) -> Result<GltfModel, SceneError> 
             "Draco-compressed meshes are not supported",
         ));
     }
-    if document.lights().is_some_and(|mut l| l.next().is_some()) {
-        log::warn!(
-            "{}: its punctual lights (KHR_lights_punctual) are ignored; only emissive materials and the environment light",
-            path.display()
-        );
-    }
     let buffers = files.buffers(&document, blob)?;
     let scene = document
         .default_scene()
@@ -118,6 +117,7 @@ pub fn load_gltf(path: &Path, transform: Mat4) -> Result<GltfModel, SceneError> 
             materials: Vec::new(),
             textures: Vec::new(),
             cameras: Vec::new(),
+            lights: Vec::new(),
         },
         ancestors: Vec::new(),
         instances: 0,
@@ -211,6 +211,9 @@ impl Walk<'_> {
         if let Some(camera) = node.camera() {
             self.camera(&camera, world);
         }
+        if let Some(light) = node.light() {
+            self.light(&light, world, &element)?;
+        }
         if let Some(mesh) = node.mesh() {
             self.instances += 1;
             if self.instances > MAX_INSTANCES {
@@ -256,6 +259,82 @@ impl Walk<'_> {
             fov_y_deg: fov,
             aspect: p.aspect_ratio().filter(|a| a.is_finite() && *a > 0.0),
         });
+    }
+
+    /// Places punctual light `light` at `world`'s origin, shining along its -z.
+    fn light(
+        &mut self,
+        light: &gltf::khr_lights_punctual::Light,
+        world: Mat4,
+        element: &str,
+    ) -> Result<(), SceneError> {
+        use gltf::khr_lights_punctual::Kind;
+        let what = format!("{element}: light {}", light.index());
+        let intensity = Vec3::from(light.color()) * light.intensity();
+        if !(intensity.is_finite() && intensity.min_element() >= 0.0) {
+            return Err(self.files.error(
+                &what,
+                format!(
+                    "colour {:?} times intensity {} must be finite and >= 0",
+                    light.color(),
+                    light.intensity()
+                ),
+            ));
+        }
+        let direction = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+        if direction == Vec3::ZERO && !matches!(light.kind(), Kind::Point) {
+            return Err(self
+                .files
+                .error(&what, "its node's transform has no -z direction"));
+        }
+        let position = world.transform_point3(Vec3::ZERO);
+        let kind = match light.kind() {
+            Kind::Directional => LightKind::Sun {
+                direction,
+                angular_diameter_deg: 0.0,
+            },
+            Kind::Point => LightKind::Point {
+                position,
+                radius: 0.0,
+                cone: None,
+            },
+            Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => {
+                let (inner, outer) = (inner_cone_angle.to_degrees(), outer_cone_angle.to_degrees());
+                if !(outer > 0.0 && outer <= 90.0 && (0.0..=outer).contains(&inner)) {
+                    return Err(self.files.error(
+                        &what,
+                        format!(
+                            "cone angles {inner_cone_angle} and {outer_cone_angle} must satisfy \
+                             0 <= inner <= outer, 0 < outer <= pi/2"
+                        ),
+                    ));
+                }
+                LightKind::Point {
+                    position,
+                    radius: 0.0,
+                    cone: Some(Cone {
+                        axis: direction,
+                        inner_deg: inner,
+                        outer_deg: outer,
+                    }),
+                }
+            }
+        };
+        self.model.lights.push(Light {
+            name: format!(
+                "{}/{}",
+                self.stem,
+                light
+                    .name()
+                    .map_or_else(|| format!("light{}", light.index()), str::to_owned)
+            ),
+            intensity,
+            kind,
+        });
+        Ok(())
     }
 
     /// Places `mesh` by `world`: each primitive read once however often the mesh is placed
@@ -313,9 +392,9 @@ impl Walk<'_> {
 }
 
 /// A scene of the glTF file `path` alone: its camera `camera` (else its first, else one
-/// framing the model from the front and a little above), its emitters and a uniform grey
-/// sky of radiance [`GREY_SKY`] (as glTF viewers light a model; a file lit by its own
-/// emitters alone, a closed room, can be rendered without it), and the default render
+/// framing the model from the front and a little above), its emitters and punctual lights,
+/// and, when it has no punctual lights, a uniform grey sky of radiance [`GREY_SKY`] (as glTF
+/// viewers light a model, even one with emissive materials), and the default render
 /// settings.
 pub fn gltf_scene(path: &Path, camera: Option<usize>) -> Result<Scene, SceneError> {
     let model = load_gltf(path, Mat4::IDENTITY)?;
@@ -339,10 +418,15 @@ pub fn gltf_scene(path: &Path, camera: Option<usize>) -> Result<Scene, SceneErro
     Ok(Scene {
         camera,
         settings: RenderSettings::from(&RenderDesc::default()),
-        environment: Environment::Constant(Vec3::splat(GREY_SKY)),
+        environment: Environment::Constant(if model.lights.is_empty() {
+            Vec3::splat(GREY_SKY)
+        } else {
+            Vec3::ZERO
+        }),
         materials: model.materials,
         textures: model.textures,
         objects: model.objects,
+        lights: model.lights,
     })
 }
 

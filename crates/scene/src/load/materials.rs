@@ -10,7 +10,6 @@ use glam::Vec3;
 use super::Builder;
 use crate::desc::{ColorSpace, MaterialDesc, ModelDesc};
 use crate::error::SceneError;
-use crate::texture::srgb_to_linear;
 use crate::{Conductor, Lobes, Material, MetalRough, Model, TextureRef};
 
 /// Every model-specific key with the model it belongs to, and whether `m` gives it (`ior`
@@ -47,23 +46,7 @@ impl Builder<'_, '_> {
         let span = desc.span();
         let m = desc.get_ref();
         let key = |field: &str| format!("materials.{name}.{field}");
-        let color = self.radiance(span.clone(), &key("color"), m.color)?;
-        let base_color = match color_space {
-            ColorSpace::Linear => color,
-            ColorSpace::Srgb => {
-                if color.max_element() > 1.0 {
-                    return Err(self.invalid(
-                        span,
-                        format!(
-                            "{} = {:?}: sRGB colours lie in [0, 1]",
-                            key("color"),
-                            m.color
-                        ),
-                    ));
-                }
-                color.to_array().map(srgb_to_linear).into()
-            }
-        };
+        let base_color = self.color(span.clone(), &key("color"), m.color, color_space)?;
         let emission = match m.emission {
             Some(e) => self.radiance(span.clone(), &key("emission"), e)?,
             None => Vec3::ZERO,

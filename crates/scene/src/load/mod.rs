@@ -1,7 +1,8 @@
 //! Building a [`Scene`] from scene-file text: validation, name resolution, asset loading.
 //! The camera, settings and environment are read here, the materials in [`materials`], the
-//! shapes and placed glTF files in [`objects`].
+//! shapes and placed glTF files in [`objects`], the lights in [`lights`].
 
+mod lights;
 mod materials;
 mod objects;
 
@@ -13,13 +14,14 @@ use std::sync::Arc;
 use glam::Vec3;
 use toml::Spanned;
 
-use crate::desc::{EnvironmentDesc, RenderDesc, SamplerDesc, SceneDesc};
+use crate::desc::{ColorSpace, EnvironmentDesc, RenderDesc, SamplerDesc, SceneDesc};
 use crate::error::RangeError;
 use crate::error::SceneError;
 use crate::settings::{
     MAX_COORDINATE, check_aperture, check_env_rotation, check_env_strength, check_length,
     check_max_depth, check_resolution, check_spp,
 };
+use crate::texture::srgb_to_linear;
 use crate::{Camera, Environment, HdrImage, RenderSettings, Sampler, Scene, Texture};
 
 /// Where a scene's text and assets come from.
@@ -108,8 +110,9 @@ impl Builder<'_, '_> {
             materials.push(self.material(name, material, desc.color_space)?);
         }
         let mut objects = self.objects(&desc, &material_ids)?;
+        let mut lights = self.lights(&desc.light, desc.color_space)?;
         for gltf in &desc.gltf {
-            self.place_gltf(gltf, &mut materials, &mut objects)?;
+            self.place_gltf(gltf, &mut materials, &mut objects, &mut lights)?;
         }
         Ok(Scene {
             camera,
@@ -118,6 +121,7 @@ impl Builder<'_, '_> {
             materials,
             textures: self.textures,
             objects,
+            lights,
         })
     }
 
@@ -246,6 +250,24 @@ impl Builder<'_, '_> {
             Ok(Vec3::from(v))
         } else {
             Err(self.invalid(span, format!("{key} = {v:?} must be finite and >= 0")))
+        }
+    }
+
+    /// A colour in the file's `color_space`, as linear RGB (sRGB values must lie in [0, 1]).
+    fn color(
+        &self,
+        span: Range<usize>,
+        key: &str,
+        v: [f32; 3],
+        color_space: ColorSpace,
+    ) -> Result<Vec3, SceneError> {
+        let color = self.radiance(span.clone(), key, v)?;
+        match color_space {
+            ColorSpace::Linear => Ok(color),
+            ColorSpace::Srgb if color.max_element() > 1.0 => {
+                Err(self.invalid(span, format!("{key} = {v:?}: sRGB colours lie in [0, 1]")))
+            }
+            ColorSpace::Srgb => Ok(color.to_array().map(srgb_to_linear).into()),
         }
     }
 

@@ -13,7 +13,7 @@ use crate::error::SceneError;
 use crate::gltf_file::load_gltf;
 use crate::revolve::Revolution;
 use crate::settings::MAX_COORDINATE;
-use crate::{Material, Object, Shape, TriangleMesh};
+use crate::{Light, Material, Object, Shape, TriangleMesh};
 
 impl Builder<'_, '_> {
     pub(super) fn objects(
@@ -193,12 +193,13 @@ impl Builder<'_, '_> {
         }
     }
 
-    /// Adds the objects, materials and textures of a `[[gltf]]` entry.
+    /// Adds the objects, materials, textures and lights of a `[[gltf]]` entry.
     pub(super) fn place_gltf(
         &mut self,
         desc: &Spanned<GltfDesc>,
         materials: &mut Vec<Material>,
         objects: &mut Vec<Object>,
+        lights: &mut Vec<Light>,
     ) -> Result<(), SceneError> {
         let d = desc.get_ref();
         let path = self.source.base_dir.join(&d.file);
@@ -221,6 +222,7 @@ impl Builder<'_, '_> {
             material: o.material + first_material,
             ..o
         }));
+        lights.extend(model.lights);
         Ok(())
     }
 }
