@@ -109,7 +109,8 @@ pub struct SceneArgs {
     #[arg(long, value_name = "FILE")]
     pub env: Option<PathBuf>,
     /// Light a glTF file opened on its own by its emitters alone, without the uniform grey
-    /// sky added to it (for a closed room lit by its own panels).
+    /// sky added to it (for a closed room lit by its own panels; a file with punctual lights
+    /// gets no sky anyway).
     #[arg(long)]
     pub no_default_env: bool,
     /// Factor on the environment map's texels (with `--env`, or on the scene's map).

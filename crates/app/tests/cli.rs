@@ -689,7 +689,7 @@ fn the_cpu_level_variable_picks_the_level_and_keeps_the_image() {
 
 /// A glTF file opened on its own is lit by the grey sky even when it has emitters (glTF
 /// viewers light a model), saying so; `--no-default-env` leaves its emitters alone; the flag
-/// is refused for a TOML scene and beside `--env`.
+/// is refused for a TOML scene and beside `--env`; a file with punctual lights gets no sky.
 #[test]
 fn a_gltf_file_opens_lit_unless_told_otherwise() {
     let dir = tempfile::tempdir().unwrap();
@@ -744,4 +744,14 @@ fn a_gltf_file_opens_lit_unless_told_otherwise() {
         ],
         &["--no-default-env and --env"],
     );
+    // A file that places punctual lights is lit by them alone: no sky behind its ground.
+    let lights = "crates/scene/tests/data/gltf/PunctualLights/lights.gltf";
+    let (err, lit) = render_small(lights, &[], &dir.path().join("lights.exr"));
+    assert!(
+        err.contains("lighting: the file's 3 punctual lights, no sky"),
+        "{err}"
+    );
+    // The ground under a sun of 2 W/m^2 at 60 degrees: about 0.78 x 2 x 0.5 / pi.
+    let mean = lit.mean()[0];
+    assert!((0.15..0.5).contains(&mean), "mean {mean}");
 }

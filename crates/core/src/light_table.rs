@@ -97,6 +97,9 @@ pub fn build(
             });
         }
     }
+    // Groups: every emissive surface together (group 0, when there are any), then each
+    // point and sun light alone.
+    let surfaces = table.len();
     let scene_radius = geometry.bounding_radius();
     for light in lights.iter().filter(|l| !l.is_dark()) {
         let (kind, power, block) = punctual(light, scene_radius);
@@ -110,9 +113,6 @@ pub fn build(
         });
         blocks.extend(block);
     }
-    // Groups: every emissive surface together (group 0, when there are any), then each
-    // point and sun light alone.
-    let surfaces = table.len();
     let group = |entry: usize| {
         if entry < surfaces {
             0
@@ -336,5 +336,99 @@ mod tests {
             Shading::build(&flat, &geometry, &Textures::build(&[])).light_count,
             0
         );
+    }
+
+    #[test]
+    fn point_and_sun_lights_are_groups_of_their_own_with_their_blocks() {
+        use pathlight_scene::{Cone, Light, LightKind};
+
+        use crate::gpu_types::{GpuLight, LIGHT_POINT, LIGHT_SUN};
+
+        let mut scene = lit(Vec3::splat(2.0));
+        let light = |kind| Light {
+            name: "l".into(),
+            intensity: Vec3::splat(1.0),
+            kind,
+        };
+        scene.lights = vec![
+            light(LightKind::Point {
+                position: Vec3::new(1.0, 2.0, 3.0),
+                radius: 0.5,
+                cone: None,
+            }),
+            light(LightKind::Point {
+                position: Vec3::ZERO,
+                radius: 0.0,
+                cone: Some(Cone {
+                    axis: Vec3::NEG_Y,
+                    inner_deg: 20.0,
+                    outer_deg: 30.0,
+                }),
+            }),
+            light(LightKind::Sun {
+                direction: Vec3::NEG_Y,
+                angular_diameter_deg: 0.53,
+            }),
+            // A dark light takes no entry.
+            Light {
+                intensity: Vec3::ZERO,
+                ..light(LightKind::Sun {
+                    direction: Vec3::NEG_Y,
+                    angular_diameter_deg: 0.0,
+                })
+            },
+        ];
+        let geometry = Geometry::build(&scene.objects).unwrap();
+        let shading = Shading::build(&scene, &geometry, &Textures::build(&[]));
+        assert_eq!(shading.light_count, 4 + 3);
+        let table = &shading.lights[..7];
+        assert_eq!(table.last().unwrap().cdf, 1.0);
+        let total: f32 = table.iter().map(|l| l.pmf).sum();
+        assert!((total - 1.0).abs() < 1e-6);
+        // Four groups (the surfaces, then each light), half chosen evenly: each at least 1/8.
+        let surfaces: f32 = table[..4].iter().map(|l| l.pmf).sum();
+        for group in [surfaces, table[4].pmf, table[5].pmf, table[6].pmf] {
+            assert!(group >= 0.125 - 1e-6, "{table:?}");
+        }
+        // Powers over pi: the surfaces 2 x (2 + pi + 0.5 + 2), the point light 4, the spot
+        // 2 (1 - (cos 20 + cos 30) / 2), the sun its irradiance x the bounding radius^2.
+        let (cos_inner, cos_outer) = (20f32.to_radians().cos(), 30f32.to_radians().cos());
+        let powers = [
+            2.0 * (4.5 + std::f32::consts::PI),
+            4.0,
+            2.0 * (1.0 - 0.5 * (cos_inner + cos_outer)),
+            geometry.bounding_radius().powi(2),
+        ];
+        let sum: f32 = powers.iter().sum();
+        let want = powers.map(|p| 0.5 * p / sum + 0.125);
+        let got = [surfaces, table[4].pmf, table[5].pmf, table[6].pmf];
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() < 1e-5, "{got:?} against {want:?}");
+        }
+        let blocks = |l: &GpuLight, n: usize| {
+            assert!(shading.param_blocks.len() >= l.index as usize + n);
+            &shading.param_blocks[l.index as usize..l.index as usize + n]
+        };
+        assert_eq!(table[4].kind, LIGHT_POINT);
+        assert_eq!(
+            blocks(&table[4], 3),
+            [
+                [1.0, 2.0, 3.0, 0.5],
+                [1.0, 1.0, 1.0, 1e30],
+                [0.0, 0.0, 1.0, -2.0]
+            ]
+        );
+        assert_eq!(table[5].kind, LIGHT_POINT);
+        let spot = blocks(&table[5], 3);
+        assert!((spot[1][3] * (cos_inner - cos_outer) - 1.0).abs() < 1e-5);
+        assert_eq!(spot[2], [0.0, -1.0, 0.0, cos_outer]);
+        assert_eq!(table[6].kind, LIGHT_SUN);
+        let sun = blocks(&table[6], 2);
+        assert_eq!(sun[0][..3], [0.0, 1.0, 0.0]);
+        // 1 - cos of the half-angle, to f32 precision although it is 1e-5.
+        let half = 0.5 * 0.53f64.to_radians();
+        assert!(((f64::from(sun[0][3]) / (1.0 - half.cos())) - 1.0).abs() < 1e-5);
+        let radiance = 1.0 / (std::f64::consts::PI * half.sin().powi(2));
+        assert!((f64::from(sun[1][3]) / radiance - 1.0).abs() < 1e-5);
     }
 }

@@ -256,6 +256,8 @@ fn host_constants_match_their_wgsl_declarations() {
         ("FLAG_ALPHA", t::FLAG_ALPHA),
         ("NO_LIGHT", t::NO_LIGHT),
         ("LIGHT_AREA", t::LIGHT_AREA),
+        ("LIGHT_POINT", t::LIGHT_POINT),
+        ("LIGHT_SUN", t::LIGHT_SUN),
         ("NO_TRIANGLE", t::NO_TRIANGLE),
         ("SHAPE_LEAF", t::SHAPE_LEAF),
         ("MATERIAL_MASK", t::MATERIAL_MASK),

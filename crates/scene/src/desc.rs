@@ -101,7 +101,7 @@ fn white() -> [f32; 3] {
 }
 
 /// A glTF 2.0 file (`.gltf` or `.glb`) placed in the scene: the triangles of its default
-/// scene with their materials (its cameras and punctual lights are not used).
+/// scene with their materials, and its punctual lights (its cameras are not used).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GltfDesc {
