@@ -79,7 +79,7 @@ fn expected(scene: &Scene, irradiance: impl Fn(Vec3) -> Vec3) -> Vec<(Vec3, bool
                     y as f32 + ((i / n) as f32 + 0.5) / n as f32,
                 );
                 let ray = primary_ray(&params, film);
-                let (origin, dir) = (Vec3::from(ray.origin), Vec3::from(ray.dir));
+                let (origin, dir) = (ray.origin, ray.dir);
                 let e = irradiance(origin - origin.z / dir.z * dir);
                 dark += usize::from(e == Vec3::ZERO);
                 sum += e;
