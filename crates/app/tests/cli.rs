@@ -751,6 +751,42 @@ fn a_gltf_file_opens_lit_unless_told_otherwise() {
         err.contains("lighting: the file's 3 punctual lights, no sky"),
         "{err}"
     );
+    // Extensions pathlight does not read are named in one warning; one the file requires
+    // refuses it.
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../..")
+            .join(lights),
+    )
+    .unwrap()
+    .replace(
+        r#""extensionsUsed": ["#,
+        r#""extensionsUsed": ["KHR_materials_sheen", "EXT_made_up", "#,
+    );
+    let unsupported = dir.path().join("unsupported.gltf");
+    std::fs::write(&unsupported, &text).unwrap();
+    let (err, _) = render_small(
+        unsupported.to_str().unwrap(),
+        &[],
+        &dir.path().join("unsupported.exr"),
+    );
+    assert!(
+        err.contains(
+            "uses glTF extensions pathlight does not support, which are ignored: \
+             KHR_materials_sheen, EXT_made_up"
+        ),
+        "{err}"
+    );
+    let required = text.replacen(
+        r#""extensions": {"#,
+        r#""extensionsRequired": ["EXT_made_up"], "extensions": {"#,
+        1,
+    );
+    std::fs::write(&unsupported, required).unwrap();
+    fails_with(
+        &["render", unsupported.to_str().unwrap()],
+        &[r#"extensionsRequired[0] = "EXT_made_up": Unsupported extension"#],
+    );
     // The ground under a sun of 2 W/m^2 at 60 degrees: about 0.78 x 2 x 0.5 / pi.
     let mean = lit.mean()[0];
     assert!((0.15..0.5).contains(&mean), "mean {mean}");

@@ -1,10 +1,11 @@
-//! Mutation fuzzing of scene files and meshes: every mutated input is either refused with an
-//! error or loaded, prepared (BVH and all) and rendered, in time; none panics or spins.
+//! Mutation fuzzing of scene files and meshes, and of glTF files (structure-aware: `fuzz/gltf.rs`):
+//! every mutated input is either refused with an error or loaded, prepared (BVH and all) and
+//! rendered, in time; none panics or spins.
 //!
 //! The suite runs a few thousand seeded cases. A long run:
 //! `PATHLIGHT_FUZZ_CASES=100000 cargo test --release -p pathlight-cpu --test fuzz`
 //! (`PATHLIGHT_FUZZ_SEED` picks another sequence). A failing case is written to
-//! `target/fuzz-failure.toml` (and `.obj`) with its seed.
+//! `target/fuzz-failure.toml` (and `.obj`), or `target/fuzz-failure-gltf/`, with its seed.
 
 use std::io::Cursor;
 use std::panic::{AssertUnwindSafe, catch_unwind};
@@ -18,8 +19,13 @@ use pathlight_scene::{SceneSource, load_scene};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
-/// Cases in the test suite (seeded, so every run tries the same ones).
+#[path = "fuzz/gltf.rs"]
+mod gltf;
+
+/// Scene-file cases in the test suite (seeded, so every run tries the same ones).
 const SUITE_CASES: u64 = 2000;
+/// glTF cases in the test suite.
+const GLTF_SUITE_CASES: u64 = 1000;
 /// Longest a case may take, load to rendered image.
 const CASE_LIMIT: Duration = Duration::from_secs(20);
 /// Numbers a mutation writes in place of one in the file.
@@ -180,43 +186,32 @@ struct Outcomes {
     rendered: u64,
 }
 
-/// Runs `cases` cases from `seed` on a worker thread, failing on a panic or a case over
-/// [`CASE_LIMIT`] (the failing input is saved under `target/`).
-fn fuzz(seed: u64, cases: u64) -> Outcomes {
-    let corpus = corpus();
-    let texture = tiny_texture();
+/// Runs `cases` cases from `seed` on a worker thread: `generate` makes each, `run` loads and
+/// renders it (`Err`: refused). Fails on a panic or a case over [`CASE_LIMIT`], after `save`
+/// has written the case under `target/` (it returns where).
+fn fuzz<C: Clone + Send + 'static>(
+    seed: u64,
+    cases: u64,
+    mut generate: impl FnMut(&mut StdRng) -> C + Send + 'static,
+    run: impl Fn(&C) -> Result<(), String> + Send + 'static,
+    save: impl Fn(&C) -> String,
+) -> Outcomes {
     let (sender, receiver) = mpsc::channel();
     let worker = std::thread::spawn(move || {
         let mut rng = StdRng::seed_from_u64(seed);
         for case in 0..cases {
-            let original = &corpus[rng.random_range(0..corpus.len())];
-            let mutate_obj = original.obj.is_some() && rng.random_bool(0.3);
-            let text = if mutate_obj && rng.random_bool(0.5) {
-                original.text.clone()
-            } else {
-                mutate(&original.text, &mut rng)
-            };
-            let obj = original.obj.as_ref().map(|(name, obj)| {
-                (
-                    *name,
-                    if mutate_obj {
-                        mutate(obj, &mut rng)
-                    } else {
-                        obj.clone()
-                    },
-                )
-            });
-            sender
-                .send(Err((case, original.name, text.clone(), obj.clone())))
-                .unwrap();
-            let result = catch_unwind(AssertUnwindSafe(|| {
-                run_case(&text, obj.as_ref().map(|(n, o)| (*n, o.as_str())), &texture)
-            }));
+            let input = generate(&mut rng);
+            sender.send(Err((case, input.clone()))).unwrap();
+            let result = catch_unwind(AssertUnwindSafe(|| run(&input)));
             sender.send(Ok(result.map(|r| r.is_ok()))).unwrap();
         }
     });
     let mut outcomes = Outcomes::default();
     let mut current = None;
+    let fail = |(case, input): (u64, C), what: &str| -> ! {
+        let saved = save(&input);
+        panic!("fuzz case {case} of seed {seed} {what}; saved to {saved}");
+    };
     loop {
         let limit = if current.is_some() {
             CASE_LIMIT
@@ -227,10 +222,10 @@ fn fuzz(seed: u64, cases: u64) -> Outcomes {
             Ok(Err(case)) => current = Some((case, Instant::now())),
             Ok(Ok(Ok(true))) => outcomes.rendered += 1,
             Ok(Ok(Ok(false))) => outcomes.refused += 1,
-            Ok(Ok(Err(_))) => fail(seed, current.take().unwrap().0, "panicked"),
+            Ok(Ok(Err(_))) => fail(current.take().unwrap().0, "panicked"),
             Err(mpsc::RecvTimeoutError::Timeout) => {
                 let (case, started) = current.take().unwrap();
-                fail(seed, case, &format!("ran {:.0?}", started.elapsed()));
+                fail(case, &format!("ran {:.0?}", started.elapsed()));
             }
             Err(mpsc::RecvTimeoutError::Disconnected) => break,
         }
@@ -239,39 +234,93 @@ fn fuzz(seed: u64, cases: u64) -> Outcomes {
     outcomes
 }
 
-/// A mutated case: its number, the corpus file, its text and its mesh.
-type Case = (u64, &'static str, String, Option<(&'static str, String)>);
+/// A mutated scene case: the corpus file, its text and its mesh.
+type SceneCase = (&'static str, String, Option<(&'static str, String)>);
 
-/// Saves the failing case and fails the test.
-fn fail(seed: u64, (case, name, text, obj): Case, what: &str) -> ! {
-    let target = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target");
-    std::fs::write(target.join("fuzz-failure.toml"), &text).unwrap();
-    if let Some((_, obj)) = obj {
-        std::fs::write(target.join("fuzz-failure.obj"), obj).unwrap();
-    }
-    panic!(
-        "fuzz case {case} of seed {seed} (a mutation of {name}) {what}; \
-         saved to target/fuzz-failure.toml"
+/// The target folder, where failing cases are saved.
+fn target() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../target")
+}
+
+/// The number of cases and the seed: `PATHLIGHT_FUZZ_CASES` (default `suite`) and
+/// `PATHLIGHT_FUZZ_SEED` (default 1).
+fn cases_and_seed(suite: u64) -> (u64, u64) {
+    let env = |name: &str| std::env::var(name).ok().map(|v| v.parse::<u64>().unwrap());
+    (
+        env("PATHLIGHT_FUZZ_CASES").unwrap_or(suite),
+        env("PATHLIGHT_FUZZ_SEED").unwrap_or(1),
+    )
+}
+
+/// Reports what became of the cases and checks that at least one in `one_in` rendered (else
+/// the render path goes untested).
+fn report(what: &str, cases: u64, started: Instant, outcomes: &Outcomes, one_in: u64) {
+    eprintln!(
+        "{what}: {cases} cases in {:.1?}: {} rendered, {} refused",
+        started.elapsed(),
+        outcomes.rendered,
+        outcomes.refused
+    );
+    assert!(
+        outcomes.rendered * one_in > cases,
+        "{what}: only {} of {cases} mutated cases rendered",
+        outcomes.rendered
     );
 }
 
 #[test]
 fn mutated_scenes_and_meshes_are_refused_or_rendered() {
-    let env = |name: &str| std::env::var(name).ok().map(|v| v.parse::<u64>().unwrap());
-    let cases = env("PATHLIGHT_FUZZ_CASES").unwrap_or(SUITE_CASES);
-    let seed = env("PATHLIGHT_FUZZ_SEED").unwrap_or(1);
+    let (cases, seed) = cases_and_seed(SUITE_CASES);
     let started = Instant::now();
-    let outcomes = fuzz(seed, cases);
-    eprintln!(
-        "{cases} cases in {:.1?}: {} rendered, {} refused",
-        started.elapsed(),
-        outcomes.rendered,
-        outcomes.refused
+    let corpus = corpus();
+    let texture = tiny_texture();
+    let generate = move |rng: &mut StdRng| -> SceneCase {
+        let original = &corpus[rng.random_range(0..corpus.len())];
+        let mutate_obj = original.obj.is_some() && rng.random_bool(0.3);
+        let text = if mutate_obj && rng.random_bool(0.5) {
+            original.text.clone()
+        } else {
+            mutate(&original.text, rng)
+        };
+        let obj = original.obj.as_ref().map(|(name, obj)| {
+            let obj = if mutate_obj {
+                mutate(obj, rng)
+            } else {
+                obj.clone()
+            };
+            (*name, obj)
+        });
+        (original.name, text, obj)
+    };
+    let run = move |(_, text, obj): &SceneCase| {
+        run_case(text, obj.as_ref().map(|(n, o)| (*n, o.as_str())), &texture)
+    };
+    let save = |(name, text, obj): &SceneCase| {
+        std::fs::write(target().join("fuzz-failure.toml"), text).unwrap();
+        if let Some((_, obj)) = obj {
+            std::fs::write(target().join("fuzz-failure.obj"), obj).unwrap();
+        }
+        format!("target/fuzz-failure.toml (a mutation of {name})")
+    };
+    let outcomes = fuzz(seed, cases, generate, run, save);
+    report("scene files", cases, started, &outcomes, 5);
+}
+
+#[test]
+fn mutated_gltf_files_are_refused_or_rendered() {
+    let (cases, seed) = cases_and_seed(GLTF_SUITE_CASES);
+    let started = Instant::now();
+    let corpus = gltf::corpus();
+    let outcomes = fuzz(
+        seed,
+        cases,
+        move |rng| gltf::generate(&corpus, rng),
+        gltf::run,
+        |case| {
+            let saved = gltf::save(case, &target());
+            format!("{} (a mutation of {})", saved.display(), case.sample)
+        },
     );
-    // The mutations must leave many cases loadable, or the render path goes untested.
-    assert!(
-        outcomes.rendered * 5 > cases,
-        "only {} of {cases} mutated cases rendered",
-        outcomes.rendered
-    );
+    // glTF is strict (an index or count out of range is an error), so fewer render.
+    report("glTF files", cases, started, &outcomes, 8);
 }

@@ -279,6 +279,48 @@ fn bad_hand_made_files_name_the_element() {
     assert!(err.contains("junk.glb: not a valid glTF file"), "{err}");
 }
 
+/// What the `gltf` crate itself panics on (found by `crates/cpu/tests/fuzz.rs`) is refused
+/// first, naming the element.
+#[test]
+fn files_that_crash_the_gltf_crate_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let refused = |name: &str, bytes: &[u8]| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        load_gltf(&path, Mat4::IDENTITY).unwrap_err().to_string()
+    };
+    // A GLB header whose length is shorter than the header (an unchecked subtraction).
+    let mut glb = std::fs::read(data("BoxTextured-glTF-Binary/BoxTextured.glb")).unwrap();
+    glb[8..12].copy_from_slice(&3u32.to_le_bytes());
+    let err = refused("short.glb", &glb);
+    assert!(
+        err.contains("GLB header: its length 3 is shorter than the 12-byte header"),
+        "{err}"
+    );
+    // A POSITION naming an accessor the file lacks (validation looks it up unchecked).
+    let path = triangle_gltf(dir.path(), r#"[{"mesh": 0}]"#, &[[0.0; 3]; 3]);
+    let text = std::fs::read_to_string(&path).unwrap();
+    let err = refused(
+        "position.gltf",
+        text.replace(r#""POSITION": 0"#, r#""POSITION": 7"#)
+            .as_bytes(),
+    );
+    assert!(
+        err.contains("mesh 0 primitive 0: POSITION names accessor 7, but the file has 1"),
+        "{err}"
+    );
+    // An image with neither a URI nor a buffer view with a MIME type (unwrapped).
+    let text = std::fs::read_to_string(data("BoxTextured-glTF-Embedded/BoxTextured.gltf")).unwrap();
+    let images = text.find(r#""images""#).unwrap();
+    let uri = images + text[images..].find(r#""uri""#).unwrap();
+    let broken = format!("{}\"name\"{}", &text[..uri], &text[uri + 5..]);
+    let err = refused("image.gltf", broken.as_bytes());
+    assert!(
+        err.contains("image 0: needs a uri, or a bufferView with a mimeType"),
+        "{err}"
+    );
+}
+
 #[test]
 fn texture_transforms_and_samplers_are_read() {
     let scene = gltf_scene(&data("textureTransform/TextureTransformTest.gltf"), None).unwrap();

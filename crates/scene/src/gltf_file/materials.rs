@@ -102,7 +102,16 @@ impl Materials {
                 files.path.display()
             );
         }
-        let thickness = material.volume().map_or(0.0, |v| v.thickness_factor());
+        let volume = material.volume();
+        let thickness = volume.as_ref().map_or(0.0, |v| v.thickness_factor());
+        if volume.as_ref().is_some_and(|v| {
+            v.attenuation_distance().is_finite() && v.attenuation_color() != [1.0; 3]
+        }) {
+            log::warn!(
+                "{}: {element}: the volume's attenuation (attenuationColor, attenuationDistance) is ignored: it is clear",
+                files.path.display()
+            );
+        }
         let alpha = match material.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
             gltf::material::AlphaMode::Mask => {

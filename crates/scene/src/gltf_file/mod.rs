@@ -6,6 +6,7 @@
 //! are skipped with a warning.
 
 mod data;
+mod guards;
 mod materials;
 mod primitives;
 
@@ -89,11 +90,16 @@ pub fn load_gltf(path: &Path, transform: Mat4) -> Result<GltfModel, SceneError> 
         path,
         base: path.parent().map(Path::to_owned).unwrap_or_default(),
     };
+    let invalid = |err: gltf::Error| SceneError::Asset {
+        path: path.to_owned(),
+        message: format!("not a valid glTF file: {err}"),
+    };
+    guards::check_glb_header(&files, &bytes)?;
     let gltf::Gltf { document, blob } =
-        gltf::Gltf::from_slice(&bytes).map_err(|err| SceneError::Asset {
-            path: path.to_owned(),
-            message: format!("not a valid glTF file: {err}"),
-        })?;
+        gltf::Gltf::from_slice_without_validation(&bytes).map_err(invalid)?;
+    guards::check_json(&files, document.as_json())?;
+    let document = gltf::Document::from_json(document.into_json()).map_err(invalid)?;
+    warn_unsupported_extensions(path, &document);
     if document
         .extensions_used()
         .any(|e| e == "KHR_draco_mesh_compression")
@@ -142,6 +148,32 @@ pub fn load_gltf(path: &Path, transform: Mat4) -> Result<GltfModel, SceneError> 
     walk.model.materials = walk.materials.materials;
     walk.model.textures = walk.materials.textures;
     Ok(walk.model)
+}
+
+/// The extensions pathlight reads (`KHR_draco_mesh_compression` is refused).
+const SUPPORTED_EXTENSIONS: [&str; 6] = [
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_transmission",
+    "KHR_materials_volume",
+    "KHR_texture_transform",
+];
+
+/// Warns once, naming them, about the extensions the file uses that pathlight ignores (a
+/// file that requires one is refused by the `gltf` crate's validation).
+fn warn_unsupported_extensions(path: &Path, document: &gltf::Document) {
+    let ignored: Vec<&str> = document
+        .extensions_used()
+        .filter(|e| !SUPPORTED_EXTENSIONS.contains(e))
+        .collect();
+    if !ignored.is_empty() {
+        log::warn!(
+            "{}: uses glTF extensions pathlight does not support, which are ignored: {}",
+            path.display(),
+            ignored.join(", ")
+        );
+    }
 }
 
 /// The depth-first walk over a scene's nodes.
