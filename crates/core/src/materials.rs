@@ -154,6 +154,7 @@ fn lobes_block(l: &Lobes) -> Vec<[f32; 4]> {
 fn metal_rough_block(m: &MetalRough) -> Vec<[f32; 4]> {
     vec![
         [m.metallic, m.roughness, m.transmission, m.ior],
-        [f32::from(u8::from(m.thin)), 0.0, 0.0, 0.0],
+        [f32::from(u8::from(m.thin)), m.specular, 0.0, 0.0],
+        m.specular_color.extend(0.0).to_array(),
     ]
 }

@@ -1,14 +1,16 @@
 //! glTF 2.0's metallic-roughness material model. Twin of `metal_rough.wgsl`.
 //!
-//! With base colour `c`, metallic `m`, transmission `t`, roughness `r` (GGX alpha = r^2)
-//! and dielectric Schlick F0 `f0 = ((ior - 1) / (ior + 1))^2`, the BSDF is the sum of
+//! With base colour `c`, metallic `m`, transmission `t`, roughness `r` (GGX alpha = r^2),
+//! specular strength `s` and colour `sc` (`KHR_materials_specular`; 1 and white by
+//! default) and dielectric Schlick F0 `f0 = min(((ior - 1) / (ior + 1))^2 sc, 1)`, the BSDF
+//! is the sum of
 //! - a GGX specular lobe (separable Smith, visible-normal sampling) with Schlick Fresnel
-//!   `F0 = m c + (1 - m)(1 - t) f0` rising to `F90 = m + (1 - m)(1 - t)` at grazing angles:
-//!   glTF's mix of the metal (F0 = c) and the dielectric (F0 = f0) specular, Schlick being
-//!   linear in F0;
-//! - a diffuse base `(1 - m)(1 - t) c / pi (1 - F(wo.h))`, F the dielectric Schlick
-//!   Fresnel and h the half vector of `wo` and `wi`: the glTF specification's
-//!   `fresnel_mix` (Appendix B). Like the specification's, this model reflects more than it
+//!   `F0 = m c + (1 - m)(1 - t) s f0` rising to `F90 = m + (1 - m)(1 - t) s` at grazing
+//!   angles: glTF's mix of the metal (F0 = c) and the dielectric (F0 = f0, weight s)
+//!   specular, Schlick being linear in F0;
+//! - a diffuse base `(1 - m)(1 - t) c / pi (1 - s max(F(wo.h)))`, F the dielectric's
+//!   coloured Schlick Fresnel and h the half vector of `wo` and `wi`: the glTF
+//!   specification's `fresnel_mix` (Appendix B and `KHR_materials_specular`). Like the specification's, this model reflects more than it
 //!   receives where the specular lobe is strong and the diffuse weight stays near
 //!   `1 - f0`: glossy dielectrics seen at grazing angles (a white one of roughness 0.2 at
 //!   `cos_o` 0.18 reflects 1.30 of what it receives, 1.03 at `cos_o` 0.5; at roughness 1
@@ -51,6 +53,10 @@ pub struct MetalRoughParams {
     pub ior: f32,
     /// Transmission through a thin wall rather than into a volume.
     pub thin: bool,
+    /// Strength of the dielectric's specular reflection (`KHR_materials_specular`).
+    pub specular: f32,
+    /// Colour multiplying the dielectric's F0.
+    pub specular_color: Vec3A,
 }
 
 impl MetalRoughParams {
@@ -63,6 +69,8 @@ impl MetalRoughParams {
             transmission: p[0].z,
             ior: p[0].w,
             thin: p[1].x != 0.0,
+            specular: p[1].y,
+            specular_color: Vec3A::new(p[2].x, p[2].y, p[2].z),
         }
     }
 }
@@ -95,23 +103,27 @@ pub struct Lobes {
     pub diffuse: f32,
     /// Weight of the dielectric interface.
     pub wall: f32,
-    /// Schlick F0 of the dielectric.
-    pub f0_d: f32,
+    /// Schlick F0 of the dielectric's specular reflection, coloured (at most 1).
+    pub f0_d: Vec3A,
+    /// Its strength (`KHR_materials_specular`'s weight).
+    pub specular: f32,
 }
 
 /// Twin of WGSL `mr_lobes`.
 #[inline(always)]
 pub fn lobes(m: &MetalRoughParams, color: Vec3A) -> Lobes {
     let r = (m.ior - 1.0) / (m.ior + 1.0);
-    let f0_d = r * r;
+    let f0_d = (r * r * m.specular_color).min(Vec3A::ONE);
     let dielectric = 1.0 - m.metallic;
     let base = dielectric * (1.0 - m.transmission);
+    let layer = base * m.specular;
     Lobes {
-        spec_f0: m.metallic * color + Vec3A::splat(base * f0_d),
-        spec_f90: m.metallic + base,
+        spec_f0: m.metallic * color + layer * f0_d,
+        spec_f90: m.metallic + layer,
         diffuse: base,
         wall: dielectric * m.transmission,
         f0_d,
+        specular: m.specular,
     }
 }
 
@@ -121,10 +133,12 @@ pub fn schlick(f0: Vec3A, f90: f32, cos_i: f32) -> Vec3A {
     f0 + (Vec3A::splat(f90) - f0) * (1.0 - cos_i.clamp(0.0, 1.0)).powi(5)
 }
 
-/// The dielectric's scalar Schlick Fresnel.
+/// What the dielectric's specular layer passes to the diffuse base at `cos_i` (the cosine
+/// with the half vector): glTF's `fresnel_mix`, `1 - specular max(F)`, F its coloured
+/// Schlick Fresnel rising to 1. Twin of WGSL `mr_coupling`.
 #[inline(always)]
-fn schlick_d(f0: f32, cos_i: f32) -> f32 {
-    f0 + (1.0 - f0) * (1.0 - cos_i.clamp(0.0, 1.0)).powi(5)
+fn coupling(l: &Lobes, cos_i: f32) -> f32 {
+    1.0 - l.specular * schlick(l.f0_d, 1.0, cos_i).max_element()
 }
 
 /// Probabilities of sampling the specular lobe, the diffuse base and the interface. Twin
@@ -133,7 +147,7 @@ fn schlick_d(f0: f32, cos_i: f32) -> f32 {
 fn probabilities(color: Vec3A, l: &Lobes, cos_o: f32) -> Vec3A {
     let lum = Vec3A::new(0.2126, 0.7152, 0.0722);
     let spec = schlick(l.spec_f0, l.spec_f90, cos_o).dot(lum);
-    let diffuse = l.diffuse * color.dot(lum) * (1.0 - schlick_d(l.f0_d, cos_o));
+    let diffuse = l.diffuse * color.dot(lum) * coupling(l, cos_o);
     let total = spec + diffuse + l.wall;
     if total > 0.0 {
         Vec3A::new(spec, diffuse, l.wall) / total
@@ -164,8 +178,8 @@ pub fn eval(m: &MetalRoughParams, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3
     if wi.dot(ng) > 0.0 && cos_i > 0.0 {
         if l.diffuse > 0.0 {
             // glTF's fresnel_mix: what the specular layer's Fresnel at the half vector passes.
-            let coupling = 1.0 - schlick_d(l.f0_d, wo.dot((wo + wi).normalize()));
-            out.f += l.diffuse * coupling * color * (cos_i * FRAC_1_PI);
+            let passed = coupling(&l, wo.dot((wo + wi).normalize()));
+            out.f += l.diffuse * passed * color * (cos_i * FRAC_1_PI);
             out.pdf += probs.y * cos_i * FRAC_1_PI;
         }
         if alpha >= ALPHA_MIN {
@@ -315,7 +329,7 @@ pub fn sample(
 #[inline(always)]
 pub fn metal_rough_albedo(m: &MetalRoughParams, color: Vec3A) -> Vec3A {
     let l = lobes(m, color);
-    l.spec_f0 + (l.diffuse * (1.0 - l.f0_d)) * color + l.wall * color
+    l.spec_f0 + (l.diffuse * coupling(&l, 1.0)) * color + l.wall * color
 }
 
 /// Whether the model has a non-delta lobe. Twin of WGSL `has_continuous_metal_rough`.

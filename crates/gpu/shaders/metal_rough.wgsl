@@ -22,12 +22,16 @@ struct MetalRoughParams {
     ior: f32,
     // Transmission through a thin wall rather than into a volume.
     thin: bool,
+    // Strength of the dielectric's specular reflection (KHR_materials_specular).
+    specular: f32,
+    // Colour multiplying the dielectric's F0.
+    specular_color: vec3f,
 }
 
 // The parameters in block `p` (a `MaterialPoint`'s `params`).
 // CPU twin: `MetalRoughParams::decode`.
 fn metal_rough_params(p: array<vec4f, MODEL_PARAMS>) -> MetalRoughParams {
-    return MetalRoughParams(p[0].x, p[0].y, p[0].z, p[0].w, p[1].x != 0.0);
+    return MetalRoughParams(p[0].x, p[0].y, p[0].z, p[0].w, p[1].x != 0.0, p[1].y, p[2].xyz);
 }
 
 // The model's texture step on block `p`: metallic times the blue and roughness times the
@@ -50,17 +54,20 @@ struct MetalRoughLobes {
     diffuse: f32,
     // Weight of the dielectric wall: (1 - metallic) transmission.
     wall: f32,
-    // Schlick F0 of the dielectric: ((ior - 1) / (ior + 1))^2.
-    f0_d: f32,
+    // Schlick F0 of the dielectric's specular reflection, coloured (at most 1).
+    f0_d: vec3f,
+    // Its strength (KHR_materials_specular's weight).
+    specular: f32,
 }
 
 // CPU twin: `lobes`.
 fn mr_lobes(m: MetalRoughParams, color: vec3f) -> MetalRoughLobes {
     let r = (m.ior - 1.0) / (m.ior + 1.0);
-    let f0_d = r * r;
+    let f0_d = min(r * r * m.specular_color, vec3f(1.0));
     let dielectric = 1.0 - m.metallic;
     let base = dielectric * (1.0 - m.transmission);
-    return MetalRoughLobes(m.metallic * color + base * f0_d, m.metallic + base, base, dielectric * m.transmission, f0_d);
+    let layer = base * m.specular;
+    return MetalRoughLobes(m.metallic * color + layer * f0_d, m.metallic + layer, base, dielectric * m.transmission, f0_d, m.specular);
 }
 
 // CPU twin: `schlick`.
@@ -68,12 +75,20 @@ fn schlick(f0: vec3f, f90: f32, cos_i: f32) -> vec3f {
     return f0 + (vec3f(f90) - f0) * pow(1.0 - saturate(cos_i), 5.0);
 }
 
+// What the dielectric's specular layer passes to the diffuse base at `cos_i` (the cosine
+// with the half vector): glTF's fresnel_mix, 1 - specular max(F).
+// CPU twin: `coupling`.
+fn mr_coupling(l: MetalRoughLobes, cos_i: f32) -> f32 {
+    let f = schlick(l.f0_d, 1.0, cos_i);
+    return 1.0 - l.specular * max(max(f.x, f.y), f.z);
+}
+
 // Probabilities of sampling the specular lobe, the diffuse base and the wall.
 // CPU twin: `probabilities`.
 fn mr_probabilities(color: vec3f, l: MetalRoughLobes, cos_o: f32) -> vec3f {
     let lum = vec3f(0.2126, 0.7152, 0.0722);
     let spec = dot(schlick(l.spec_f0, l.spec_f90, cos_o), lum);
-    let diffuse = l.diffuse * dot(color, lum) * (1.0 - schlick(vec3f(l.f0_d), 1.0, cos_o).x);
+    let diffuse = l.diffuse * dot(color, lum) * mr_coupling(l, cos_o);
     let total = spec + diffuse + l.wall;
     if !(total > 0.0) {
         return vec3f(0.0);
@@ -101,8 +116,8 @@ fn eval_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, wi
     if dot(wi, ng) > 0.0 && cos_i > 0.0 {
         if l.diffuse > 0.0 {
             // glTF's fresnel_mix: what the specular layer's Fresnel at the half vector passes.
-            let coupling = 1.0 - schlick(vec3f(l.f0_d), 1.0, dot(wo, normalize(wo + wi))).x;
-            out.f += l.diffuse * coupling * color * (cos_i / PI);
+            let passed = mr_coupling(l, dot(wo, normalize(wo + wi)));
+            out.f += l.diffuse * passed * color * (cos_i / PI);
             out.pdf += probs.y * cos_i / PI;
         }
         if alpha >= ALPHA_MIN {
@@ -220,7 +235,7 @@ fn sample_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, 
 // CPU twin: `metal_rough_albedo`.
 fn metal_rough_albedo(m: MetalRoughParams, color: vec3f) -> vec3f {
     let l = mr_lobes(m, color);
-    return l.spec_f0 + (l.diffuse * (1.0 - l.f0_d)) * color + l.wall * color;
+    return l.spec_f0 + (l.diffuse * mr_coupling(l, 1.0)) * color + l.wall * color;
 }
 
 // Whether the model has a non-delta lobe.

@@ -260,6 +260,12 @@ pub struct MaterialDesc {
     /// Metal-rough: fraction of the dielectric base that transmits, through a
     /// thin wall (`KHR_materials_transmission`).
     pub transmission: Option<f32>,
+    /// Metal-rough: strength of the dielectric's specular reflection, in [0, 1]
+    /// (`KHR_materials_specular`'s `specularFactor`).
+    pub specular: Option<f32>,
+    /// Metal-rough: linear colour multiplying the dielectric's F0 (`specularColorFactor`).
+    #[serde(default, deserialize_with = "exact::optional_array")]
+    pub specular_color: Option<[f32; 3]>,
 }
 
 /// A material model, as `model = "..."` names it.

@@ -276,6 +276,12 @@ pub struct MetalRough {
     pub transmission: f32,
     /// Transmission through a thin wall (no volume): rays leave undeviated by refraction.
     pub thin: bool,
+    /// Strength of the dielectric's specular reflection, `KHR_materials_specular`'s
+    /// `specularFactor` (1: glTF's plain dielectric; 0: none, the base alone).
+    pub specular: f32,
+    /// Linear colour multiplying the dielectric's F0 (`specularColorFactor`; white: glTF's
+    /// plain dielectric).
+    pub specular_color: Vec3,
 }
 
 impl MetalRough {
@@ -288,5 +294,7 @@ impl MetalRough {
         ior: 1.5,
         transmission: 0.0,
         thin: true,
+        specular: 1.0,
+        specular_color: Vec3::ONE,
     };
 }

@@ -551,3 +551,34 @@ fn bad_punctual_lights_are_refused_naming_the_node() {
     let message = file(r#""intensity": 1.0"#, r#""intensity": -3.0"#);
     assert!(message.contains("node 1: light 0: colour"), "{message}");
 }
+
+#[test]
+fn specular_factors_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(data("PunctualLights/lights.gltf"))
+        .unwrap()
+        .replacen(
+            r#""pbrMetallicRoughness": {"#,
+            r#""extensions": {"KHR_materials_specular": {"specularFactor": 0.3,
+                "specularColorFactor": [1, 0.5, 0.25]}}, "pbrMetallicRoughness": {"#,
+            1,
+        )
+        .replace(
+            r#""extensionsUsed": ["#,
+            r#""extensionsUsed": ["KHR_materials_specular", "#,
+        );
+    let path = dir.path().join("specular.gltf");
+    std::fs::write(&path, text).unwrap();
+    let scene = gltf_scene(&path, None).unwrap();
+    let Model::MetalRough(m) = &scene.materials[0].model else {
+        panic!("{:?}", scene.materials[0])
+    };
+    assert_eq!(m.specular, 0.3);
+    assert_eq!(m.specular_color, Vec3::new(1.0, 0.5, 0.25));
+    // Without the extension: glTF's plain dielectric.
+    let plain = gltf_scene(&data("PunctualLights/lights.gltf"), None).unwrap();
+    let Model::MetalRough(m) = &plain.materials[0].model else {
+        panic!("{:?}", plain.materials[0])
+    };
+    assert_eq!((m.specular, m.specular_color), (1.0, Vec3::ONE));
+}

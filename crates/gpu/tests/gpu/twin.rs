@@ -3,8 +3,9 @@
 //! choice (lobe, roulette). Checked on every material and emitter kind, and on the
 //! auxiliary images.
 
+use glam::Vec3;
 use pathlight_core::{Film, PreparedScene, Renderer};
-use pathlight_scene::{LightKind, Scene};
+use pathlight_scene::{LightKind, MetalRough, Model, Scene};
 
 use crate::common::{gpu_renderer, render, render_cpu, render_to, scene};
 
@@ -56,9 +57,17 @@ fn gpu_and_cpu_render_the_same_image() {
 }
 
 /// The lights reference scene with every light made soft: the point light a sphere, the
-/// spot's edge smooth (and its light from a sphere too), the sun a disk of 5 degrees.
+/// spot's edge smooth (and its light from a sphere too), the sun a disk of 5 degrees; and
+/// its white sphere a glTF dielectric with a coloured `KHR_materials_specular`.
 fn soft_lights() -> Scene {
     let mut s = scene("refs/lights.toml", 40, 4, 2);
+    let white = s.materials.iter_mut().find(|m| m.name == "white").unwrap();
+    white.model = Model::MetalRough(MetalRough {
+        roughness: 0.4,
+        specular: 0.6,
+        specular_color: Vec3::new(1.0, 0.5, 2.0),
+        ..MetalRough::DEFAULT
+    });
     for light in &mut s.lights {
         match &mut light.kind {
             LightKind::Point { radius, cone, .. } => {

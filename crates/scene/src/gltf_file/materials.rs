@@ -102,6 +102,16 @@ impl Materials {
                 files.path.display()
             );
         }
+        let specular = material.specular();
+        if specular
+            .as_ref()
+            .is_some_and(|s| s.specular_texture().is_some() || s.specular_color_texture().is_some())
+        {
+            log::warn!(
+                "{}: {element}: the specular textures are ignored (their factors are used)",
+                files.path.display()
+            );
+        }
         let volume = material.volume();
         let thickness = volume.as_ref().map_or(0.0, |v| v.thickness_factor());
         if volume.as_ref().is_some_and(|v| {
@@ -126,6 +136,10 @@ impl Materials {
             ior: material.ior().unwrap_or(1.5),
             transmission: transmission.map_or(0.0, |t| t.transmission_factor()),
             thin: thickness <= 0.0,
+            specular: specular.as_ref().map_or(1.0, |s| s.specular_factor()),
+            specular_color: specular
+                .as_ref()
+                .map_or(Vec3::ONE, |s| Vec3::from(s.specular_color_factor())),
         };
         let numbers = [
             r,
@@ -140,6 +154,10 @@ impl Materials {
             emission.x,
             emission.y,
             emission.z,
+            metal_rough.specular,
+            metal_rough.specular_color.x,
+            metal_rough.specular_color.y,
+            metal_rough.specular_color.z,
         ];
         if numbers.iter().any(|v| !v.is_finite() || *v < 0.0) || metal_rough.ior < 1.0 {
             return Err(files.error(
@@ -167,6 +185,7 @@ impl Materials {
                 metallic: metal_rough.metallic.min(1.0),
                 roughness: metal_rough.roughness.min(1.0),
                 transmission: metal_rough.transmission.min(1.0),
+                specular: metal_rough.specular.min(1.0),
                 ..metal_rough
             }),
         };

@@ -151,10 +151,11 @@ pub fn load_gltf(path: &Path, transform: Mat4) -> Result<GltfModel, SceneError> 
 }
 
 /// The extensions pathlight reads (`KHR_draco_mesh_compression` is refused).
-const SUPPORTED_EXTENSIONS: [&str; 6] = [
+const SUPPORTED_EXTENSIONS: [&str; 7] = [
     "KHR_lights_punctual",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
+    "KHR_materials_specular",
     "KHR_materials_transmission",
     "KHR_materials_volume",
     "KHR_texture_transform",

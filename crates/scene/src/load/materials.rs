@@ -14,7 +14,7 @@ use crate::{Conductor, Lobes, Material, MetalRough, Model, TextureRef};
 
 /// Every model-specific key with the model it belongs to, and whether `m` gives it (`ior`
 /// belongs to both models and is not listed).
-fn model_keys(m: &MaterialDesc) -> [(ModelDesc, &'static str, bool); 11] {
+fn model_keys(m: &MaterialDesc) -> [(ModelDesc, &'static str, bool); 13] {
     use ModelDesc::{Lobes, MetalRough};
     [
         (Lobes, "preset", m.preset.is_some()),
@@ -32,6 +32,8 @@ fn model_keys(m: &MaterialDesc) -> [(ModelDesc, &'static str, bool); 11] {
         (MetalRough, "metallic", m.metallic.is_some()),
         (MetalRough, "roughness", m.roughness.is_some()),
         (MetalRough, "transmission", m.transmission.is_some()),
+        (MetalRough, "specular", m.specular.is_some()),
+        (MetalRough, "specular_color", m.specular_color.is_some()),
     ]
 }
 
@@ -202,7 +204,16 @@ impl Builder<'_, '_> {
         Ok(MetalRough {
             metallic: self.unit(span.clone(), &key("metallic"), m.metallic.unwrap_or(0.0))?,
             roughness: self.unit(span.clone(), &key("roughness"), m.roughness.unwrap_or(1.0))?,
-            transmission: self.unit(span, &key("transmission"), m.transmission.unwrap_or(0.0))?,
+            transmission: self.unit(
+                span.clone(),
+                &key("transmission"),
+                m.transmission.unwrap_or(0.0),
+            )?,
+            specular: self.unit(span.clone(), &key("specular"), m.specular.unwrap_or(1.0))?,
+            specular_color: match m.specular_color {
+                Some(c) => self.radiance(span, &key("specular_color"), c)?,
+                None => Vec3::ONE,
+            },
             ior,
             ..MetalRough::DEFAULT
         })
