@@ -148,13 +148,19 @@ fn lobes_block(l: &Lobes) -> Vec<[f32; 4]> {
 }
 
 /// The metal-rough model's block (WGSL `metal_rough_params`, CPU `MetalRoughParams::decode`):
-/// `[metallic, roughness, transmission, ior]`, `[thin (1 or 0), 0, 0, 0]`. Its one texture
+/// `[metallic, roughness, transmission, ior]`, `[thin (1 or 0), specular, clearcoat,
+/// clearcoat roughness]`, `[specular colour, 0]`. Its one texture
 /// is slot [`TEXTURE_MODEL`](crate::gpu_types::TEXTURE_MODEL): metallic in blue, roughness
 /// in green.
 fn metal_rough_block(m: &MetalRough) -> Vec<[f32; 4]> {
     vec![
         [m.metallic, m.roughness, m.transmission, m.ior],
-        [f32::from(u8::from(m.thin)), m.specular, 0.0, 0.0],
+        [
+            f32::from(u8::from(m.thin)),
+            m.specular,
+            m.clearcoat,
+            m.clearcoat_roughness,
+        ],
         m.specular_color.extend(0.0).to_array(),
     ]
 }

@@ -20,7 +20,14 @@
 //!   surface, tinted by `c`; smooth, it passes straight through) or, with
 //!   `KHR_materials_volume`, the rough dielectric of [`crate::microfacet`] tinted by `c`.
 //!
-//! Lobes are sampled in proportion to their estimated albedo at `wo`.
+//! A clear coat of strength `k` and roughness `r_c` (`KHR_materials_clearcoat`) lies over
+//! all of it: the extension's `fresnel_coat`, the material above weighted by
+//! `1 - k F_c(n.wo)` and a GGX lobe of alpha `r_c^2` without Fresnel by `k F_c(n.wo)`, F_c
+//! Schlick's from 0.04 (ior 1.5) at the shading normal (the coat's own normal map is not
+//! read).
+//!
+//! Lobes are sampled in proportion to their estimated albedo at `wo`; the coat with
+//! probability `k F_c(n.wo)`, its weight.
 
 use std::f32::consts::FRAC_1_PI;
 
@@ -57,6 +64,10 @@ pub struct MetalRoughParams {
     pub specular: f32,
     /// Colour multiplying the dielectric's F0.
     pub specular_color: Vec3A,
+    /// Strength of the clear coat (`KHR_materials_clearcoat`).
+    pub clearcoat: f32,
+    /// The coat's perceptual roughness.
+    pub clearcoat_roughness: f32,
 }
 
 impl MetalRoughParams {
@@ -71,6 +82,8 @@ impl MetalRoughParams {
             thin: p[1].x != 0.0,
             specular: p[1].y,
             specular_color: Vec3A::new(p[2].x, p[2].y, p[2].z),
+            clearcoat: p[1].z,
+            clearcoat_roughness: p[1].w,
         }
     }
 }
@@ -156,9 +169,44 @@ fn probabilities(color: Vec3A, l: &Lobes, cos_o: f32) -> Vec3A {
     }
 }
 
-/// The continuous part of the BSDF. Twin of WGSL `eval_metal_rough`.
+/// The continuous part of the BSDF: the coat over the rest. Twin of WGSL `eval_metal_rough`.
 #[inline(always)]
 pub fn eval(m: &MetalRoughParams, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfEval {
+    let base = eval_base(m, color, s, wo, wi);
+    if m.clearcoat <= 0.0 {
+        return base;
+    }
+    let sign = if wo.dot(s.ng) >= 0.0 { 1.0 } else { -1.0 };
+    let (ng, n) = (s.ng * sign, s.ns * sign);
+    let weight = coat_weight(m, wo.dot(n));
+    let mut out = BsdfEval {
+        f: base.f * (1.0 - weight),
+        pdf: base.pdf * (1.0 - weight),
+    };
+    let alpha = m.clearcoat_roughness * m.clearcoat_roughness;
+    if alpha >= ALPHA_MIN && wi.dot(ng) > 0.0 && wi.dot(n) > 0.0 && wo.dot(n) > 0.0 {
+        let frame = Frame::around(n);
+        let (wo_l, wi_l) = (frame.to_local(wo), frame.to_local(wi));
+        let h = (wo_l + wi_l).normalize();
+        let d = ggx_d(h, alpha);
+        let g1o = ggx_g1(wo_l, alpha);
+        out.f += Vec3A::splat(weight * d * g1o * ggx_g1(wi_l, alpha) / (4.0 * wo_l.z));
+        out.pdf += weight * g1o * d / (4.0 * wo_l.z);
+    }
+    out
+}
+
+/// The coat's weight at `cos_o` (the cosine of `wo` with the shading normal): its strength
+/// times Schlick's Fresnel from 0.04, which is also its sampling probability. Twin of WGSL
+/// `mr_coat_weight`.
+#[inline(always)]
+fn coat_weight(m: &MetalRoughParams, cos_o: f32) -> f32 {
+    m.clearcoat * schlick(Vec3A::splat(0.04), 1.0, cos_o).x
+}
+
+/// The continuous part of the BSDF under the coat. Twin of WGSL `eval_metal_rough_base`.
+#[inline(always)]
+fn eval_base(m: &MetalRoughParams, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfEval {
     let sign = if wo.dot(s.ng) >= 0.0 { 1.0 } else { -1.0 };
     let (ng, n) = (s.ng * sign, s.ns * sign);
     let l = lobes(m, color);
@@ -246,7 +294,8 @@ fn delta(wi: Vec3A, weight: Vec3A, valid: bool) -> BsdfSample {
     }
 }
 
-/// Samples an incident direction. Twin of WGSL `sample_metal_rough`.
+/// Samples an incident direction: the coat with probability its weight, else the
+/// material under it. Twin of WGSL `sample_metal_rough`.
 #[inline(always)]
 pub fn sample(
     m: &MetalRoughParams,
@@ -263,6 +312,29 @@ pub fn sample(
     if cos_o <= 0.0 {
         return INVALID;
     }
+    let coat = if m.clearcoat > 0.0 {
+        coat_weight(m, cos_o)
+    } else {
+        0.0
+    };
+    if u_lobe < coat {
+        let alpha = m.clearcoat_roughness * m.clearcoat_roughness;
+        if alpha < ALPHA_MIN {
+            // A mirror coat: its weight over its probability is 1.
+            let wi = 2.0 * cos_o * n - wo;
+            return delta(wi, Vec3A::ONE, wi.dot(ng) > 0.0);
+        }
+        let frame = Frame::around(n);
+        let wo_l = frame.to_local(wo);
+        let h = ggx_sample_visible(wo_l, alpha, u);
+        let wi_l = 2.0 * wo_l.dot(h) * h - wo_l;
+        if wi_l.z <= 0.0 {
+            return INVALID;
+        }
+        return mixture_sample(m, color, s, wo, frame.to_world(wi_l));
+    }
+    // The material under the coat, from what is left of u_lobe.
+    let u_lobe = (u_lobe - coat) / (1.0 - coat);
     let l = lobes(m, color);
     let probs = probabilities(color, &l, cos_o);
     let alpha = m.roughness * m.roughness;
@@ -329,11 +401,15 @@ pub fn sample(
 #[inline(always)]
 pub fn metal_rough_albedo(m: &MetalRoughParams, color: Vec3A) -> Vec3A {
     let l = lobes(m, color);
-    l.spec_f0 + (l.diffuse * coupling(&l, 1.0)) * color + l.wall * color
+    let base = l.spec_f0 + (l.diffuse * coupling(&l, 1.0)) * color + l.wall * color;
+    let coat = coat_weight(m, 1.0);
+    base * (1.0 - coat) + Vec3A::splat(coat)
 }
 
 /// Whether the model has a non-delta lobe. Twin of WGSL `has_continuous_metal_rough`.
 #[inline(always)]
 pub fn has_continuous_metal_rough(m: &MetalRoughParams, color: Vec3A) -> bool {
-    lobes(m, color).diffuse > 0.0 || m.roughness * m.roughness >= ALPHA_MIN
+    lobes(m, color).diffuse > 0.0
+        || m.roughness * m.roughness >= ALPHA_MIN
+        || (m.clearcoat > 0.0 && m.clearcoat_roughness * m.clearcoat_roughness >= ALPHA_MIN)
 }

@@ -1,7 +1,7 @@
 // glTF 2.0's metallic-roughness material model. CPU twin: `crates/cpu/src/metal_rough.rs`,
 // whose header states the model: a mixture of a GGX specular lobe with Schlick Fresnel, a
 // diffuse base under it weighted as glTF's `fresnel_mix` and a dielectric wall
-// (transmission), weighted by metallic and transmission.
+// (transmission), weighted by metallic and transmission, under a clear coat.
 
 #import scene
 #import textures
@@ -26,12 +26,16 @@ struct MetalRoughParams {
     specular: f32,
     // Colour multiplying the dielectric's F0.
     specular_color: vec3f,
+    // Strength of the clear coat (KHR_materials_clearcoat).
+    clearcoat: f32,
+    // The coat's perceptual roughness.
+    clearcoat_roughness: f32,
 }
 
 // The parameters in block `p` (a `MaterialPoint`'s `params`).
 // CPU twin: `MetalRoughParams::decode`.
 fn metal_rough_params(p: array<vec4f, MODEL_PARAMS>) -> MetalRoughParams {
-    return MetalRoughParams(p[0].x, p[0].y, p[0].z, p[0].w, p[1].x != 0.0, p[1].y, p[2].xyz);
+    return MetalRoughParams(p[0].x, p[0].y, p[0].z, p[0].w, p[1].x != 0.0, p[1].y, p[2].xyz, p[1].z, p[1].w);
 }
 
 // The model's texture step on block `p`: metallic times the blue and roughness times the
@@ -96,8 +100,42 @@ fn mr_probabilities(color: vec3f, l: MetalRoughLobes, cos_o: f32) -> vec3f {
     return vec3f(spec, diffuse, l.wall) / total;
 }
 
+// The continuous part of the BSDF: the coat over the rest.
 // CPU twin: `eval`.
 fn eval_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, wi: vec3f) -> BsdfEval {
+    let base = eval_metal_rough_base(m, color, s, wo, wi);
+    if m.clearcoat <= 0.0 {
+        return base;
+    }
+    let front = dot(wo, s.ng) >= 0.0;
+    let ng = select(-s.ng, s.ng, front);
+    let n = select(-s.ns, s.ns, front);
+    let weight = mr_coat_weight(m, dot(wo, n));
+    var out = BsdfEval(base.f * (1.0 - weight), base.pdf * (1.0 - weight));
+    let alpha = m.clearcoat_roughness * m.clearcoat_roughness;
+    if alpha >= ALPHA_MIN && dot(wi, ng) > 0.0 && dot(wi, n) > 0.0 && dot(wo, n) > 0.0 {
+        let frame = frame_around(n);
+        let wo_l = to_local(frame, wo);
+        let wi_l = to_local(frame, wi);
+        let h = normalize(wo_l + wi_l);
+        let d = ggx_d(h, alpha);
+        let g1o = ggx_g1(wo_l, alpha);
+        out.f += vec3f(weight * d * g1o * ggx_g1(wi_l, alpha) / (4.0 * wo_l.z));
+        out.pdf += weight * g1o * d / (4.0 * wo_l.z);
+    }
+    return out;
+}
+
+// The coat's weight at cos_o: its strength times Schlick's Fresnel from 0.04, which is also
+// its sampling probability.
+// CPU twin: `coat_weight`.
+fn mr_coat_weight(m: MetalRoughParams, cos_o: f32) -> f32 {
+    return m.clearcoat * schlick(vec3f(0.04), 1.0, cos_o).x;
+}
+
+// The continuous part of the BSDF under the coat.
+// CPU twin: `eval_base`.
+fn eval_metal_rough_base(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, wi: vec3f) -> BsdfEval {
     let front = dot(wo, s.ng) >= 0.0;
     let ng = select(-s.ng, s.ng, front);
     let n = select(-s.ns, s.ns, front);
@@ -173,12 +211,34 @@ fn sample_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, 
     if cos_o <= 0.0 {
         return invalid_sample();
     }
+    var coat = 0.0;
+    if m.clearcoat > 0.0 {
+        coat = mr_coat_weight(m, cos_o);
+    }
+    if u_lobe < coat {
+        let alpha_c = m.clearcoat_roughness * m.clearcoat_roughness;
+        if alpha_c < ALPHA_MIN {
+            // A mirror coat: its weight over its probability is 1.
+            let wi = 2.0 * cos_o * n - wo;
+            return BsdfSample(wi, vec3f(1.0), 0.0, true, 1.0, dot(wi, ng) > 0.0);
+        }
+        let frame_c = frame_around(n);
+        let h = ggx_sample_visible(to_local(frame_c, wo), alpha_c, u);
+        let wo_c = to_local(frame_c, wo);
+        let wi_l = 2.0 * dot(wo_c, h) * h - wo_c;
+        if wi_l.z <= 0.0 {
+            return invalid_sample();
+        }
+        return mr_mixture_sample(m, color, s, wo, frame_c * wi_l);
+    }
+    // The material under the coat, from what is left of u_lobe.
+    let u_base = (u_lobe - coat) / (1.0 - coat);
     let l = mr_lobes(m, color);
     let probs = mr_probabilities(color, l, cos_o);
     let alpha = m.roughness * m.roughness;
     let frame = frame_around(n);
     let wo_l = to_local(frame, wo);
-    if u_lobe < probs.x {
+    if u_base < probs.x {
         if alpha < ALPHA_MIN {
             let wi = 2.0 * cos_o * n - wo;
             if dot(wi, ng) <= 0.0 {
@@ -193,7 +253,7 @@ fn sample_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, 
         }
         return mr_mixture_sample(m, color, s, wo, frame * wi_l);
     }
-    if u_lobe < probs.x + probs.z {
+    if u_base < probs.x + probs.z {
         if m.thin {
             if alpha < ALPHA_MIN {
                 let fr = fresnel_dielectric(cos_o, m.ior);
@@ -235,11 +295,14 @@ fn sample_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, 
 // CPU twin: `metal_rough_albedo`.
 fn metal_rough_albedo(m: MetalRoughParams, color: vec3f) -> vec3f {
     let l = mr_lobes(m, color);
-    return l.spec_f0 + (l.diffuse * mr_coupling(l, 1.0)) * color + l.wall * color;
+    let base = l.spec_f0 + (l.diffuse * mr_coupling(l, 1.0)) * color + l.wall * color;
+    let coat = mr_coat_weight(m, 1.0);
+    return base * (1.0 - coat) + vec3f(coat);
 }
 
 // Whether the model has a non-delta lobe.
 // CPU twin: `has_continuous_metal_rough`.
 fn has_continuous_metal_rough(m: MetalRoughParams, color: vec3f) -> bool {
-    return mr_lobes(m, color).diffuse > 0.0 || m.roughness * m.roughness >= ALPHA_MIN;
+    return mr_lobes(m, color).diffuse > 0.0 || m.roughness * m.roughness >= ALPHA_MIN
+        || (m.clearcoat > 0.0 && m.clearcoat_roughness * m.clearcoat_roughness >= ALPHA_MIN);
 }

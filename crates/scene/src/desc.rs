@@ -266,6 +266,11 @@ pub struct MaterialDesc {
     /// Metal-rough: linear colour multiplying the dielectric's F0 (`specularColorFactor`).
     #[serde(default, deserialize_with = "exact::optional_array")]
     pub specular_color: Option<[f32; 3]>,
+    /// Metal-rough: strength of a clear coat over the material, in [0, 1]
+    /// (`KHR_materials_clearcoat`'s `clearcoatFactor`).
+    pub clearcoat: Option<f32>,
+    /// Metal-rough: the coat's perceptual roughness, in [0, 1].
+    pub clearcoat_roughness: Option<f32>,
 }
 
 /// A material model, as `model = "..."` names it.

@@ -282,6 +282,11 @@ pub struct MetalRough {
     /// Linear colour multiplying the dielectric's F0 (`specularColorFactor`; white: glTF's
     /// plain dielectric).
     pub specular_color: Vec3,
+    /// Strength of a clear coat over the whole material (`KHR_materials_clearcoat`'s
+    /// `clearcoatFactor`; 0: none).
+    pub clearcoat: f32,
+    /// The coat's perceptual roughness (`clearcoatRoughnessFactor`).
+    pub clearcoat_roughness: f32,
 }
 
 impl MetalRough {
@@ -296,5 +301,7 @@ impl MetalRough {
         thin: true,
         specular: 1.0,
         specular_color: Vec3::ONE,
+        clearcoat: 0.0,
+        clearcoat_roughness: 0.0,
     };
 }

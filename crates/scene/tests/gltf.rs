@@ -553,19 +553,21 @@ fn bad_punctual_lights_are_refused_naming_the_node() {
 }
 
 #[test]
-fn specular_factors_are_read() {
+fn specular_and_clearcoat_factors_are_read() {
     let dir = tempfile::tempdir().unwrap();
     let text = std::fs::read_to_string(data("PunctualLights/lights.gltf"))
         .unwrap()
         .replacen(
             r#""pbrMetallicRoughness": {"#,
             r#""extensions": {"KHR_materials_specular": {"specularFactor": 0.3,
-                "specularColorFactor": [1, 0.5, 0.25]}}, "pbrMetallicRoughness": {"#,
+                "specularColorFactor": [1, 0.5, 0.25]}, "KHR_materials_clearcoat":
+                {"clearcoatFactor": 0.7, "clearcoatRoughnessFactor": 0.2}},
+                "pbrMetallicRoughness": {"#,
             1,
         )
         .replace(
             r#""extensionsUsed": ["#,
-            r#""extensionsUsed": ["KHR_materials_specular", "#,
+            r#""extensionsUsed": ["KHR_materials_specular", "KHR_materials_clearcoat", "#,
         );
     let path = dir.path().join("specular.gltf");
     std::fs::write(&path, text).unwrap();
@@ -575,10 +577,12 @@ fn specular_factors_are_read() {
     };
     assert_eq!(m.specular, 0.3);
     assert_eq!(m.specular_color, Vec3::new(1.0, 0.5, 0.25));
+    assert_eq!((m.clearcoat, m.clearcoat_roughness), (0.7, 0.2));
     // Without the extension: glTF's plain dielectric.
     let plain = gltf_scene(&data("PunctualLights/lights.gltf"), None).unwrap();
     let Model::MetalRough(m) = &plain.materials[0].model else {
         panic!("{:?}", plain.materials[0])
     };
     assert_eq!((m.specular, m.specular_color), (1.0, Vec3::ONE));
+    assert_eq!((m.clearcoat, m.clearcoat_roughness), (0.0, 0.0));
 }

@@ -34,6 +34,15 @@ fn metal_rough_furnaces_read_one_on_both_backends() {
             },
         ),
         (
+            "smooth white metal under a smooth clear coat",
+            MetalRough {
+                metallic: 1.0,
+                roughness: 0.0,
+                clearcoat: 1.0,
+                ..MetalRough::DEFAULT
+            },
+        ),
+        (
             "smooth thin wall",
             MetalRough {
                 roughness: 0.0,

@@ -58,7 +58,8 @@ fn gpu_and_cpu_render_the_same_image() {
 
 /// The lights reference scene with every light made soft: the point light a sphere, the
 /// spot's edge smooth (and its light from a sphere too), the sun a disk of 5 degrees; and
-/// its white sphere a glTF dielectric with a coloured `KHR_materials_specular`.
+/// its white sphere a glTF dielectric with a coloured `KHR_materials_specular`, its blue one
+/// under a clear coat.
 fn soft_lights() -> Scene {
     let mut s = scene("refs/lights.toml", 40, 4, 2);
     let white = s.materials.iter_mut().find(|m| m.name == "white").unwrap();
@@ -66,6 +67,13 @@ fn soft_lights() -> Scene {
         roughness: 0.4,
         specular: 0.6,
         specular_color: Vec3::new(1.0, 0.5, 2.0),
+        ..MetalRough::DEFAULT
+    });
+    let blue = s.materials.iter_mut().find(|m| m.name == "blue").unwrap();
+    blue.model = Model::MetalRough(MetalRough {
+        roughness: 0.8,
+        clearcoat: 1.0,
+        clearcoat_roughness: 0.2,
         ..MetalRough::DEFAULT
     });
     for light in &mut s.lights {

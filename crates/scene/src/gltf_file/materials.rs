@@ -102,6 +102,7 @@ impl Materials {
                 files.path.display()
             );
         }
+        let (clearcoat, clearcoat_roughness) = clearcoat(files, &element, material);
         let specular = material.specular();
         if specular
             .as_ref()
@@ -140,6 +141,8 @@ impl Materials {
             specular_color: specular
                 .as_ref()
                 .map_or(Vec3::ONE, |s| Vec3::from(s.specular_color_factor())),
+            clearcoat,
+            clearcoat_roughness,
         };
         let numbers = [
             r,
@@ -158,6 +161,8 @@ impl Materials {
             metal_rough.specular_color.x,
             metal_rough.specular_color.y,
             metal_rough.specular_color.z,
+            metal_rough.clearcoat,
+            metal_rough.clearcoat_roughness,
         ];
         if numbers.iter().any(|v| !v.is_finite() || *v < 0.0) || metal_rough.ior < 1.0 {
             return Err(files.error(
@@ -186,6 +191,8 @@ impl Materials {
                 roughness: metal_rough.roughness.min(1.0),
                 transmission: metal_rough.transmission.min(1.0),
                 specular: metal_rough.specular.min(1.0),
+                clearcoat: metal_rough.clearcoat.min(1.0),
+                clearcoat_roughness: metal_rough.clearcoat_roughness.min(1.0),
                 ..metal_rough
             }),
         };
@@ -258,4 +265,32 @@ pub(super) fn uv_matrix(t: &gltf::texture::TextureTransform) -> [[f32; 3]; 2] {
     let [sx, sy] = t.scale();
     let (s, c) = t.rotation().sin_cos();
     [[c * sx, s * sy, ox], [-s * sx, c * sy, oy]]
+}
+
+/// `KHR_materials_clearcoat`'s factors (the `gltf` crate does not read it): strength and
+/// roughness, 0 and 0 without it (NaN for a value that is not a number, refused with the
+/// other factors); its textures are ignored with a warning.
+fn clearcoat(files: &Files, element: &str, material: &gltf::Material) -> (f32, f32) {
+    let Some(coat) = material.extension_value("KHR_materials_clearcoat") else {
+        return (0.0, 0.0);
+    };
+    let textures = [
+        "clearcoatTexture",
+        "clearcoatRoughnessTexture",
+        "clearcoatNormalTexture",
+    ];
+    if textures.iter().any(|k| coat.get(k).is_some()) {
+        log::warn!(
+            "{}: {element}: the clear coat's textures are ignored (its factors are used)",
+            files.path.display()
+        );
+    }
+    let factor = |key: &str| match coat.get(key) {
+        None => 0.0,
+        Some(v) => v.as_f64().map_or(f32::NAN, |f| f as f32),
+    };
+    (
+        factor("clearcoatFactor"),
+        factor("clearcoatRoughnessFactor"),
+    )
 }

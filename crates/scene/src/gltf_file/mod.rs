@@ -151,8 +151,9 @@ pub fn load_gltf(path: &Path, transform: Mat4) -> Result<GltfModel, SceneError> 
 }
 
 /// The extensions pathlight reads (`KHR_draco_mesh_compression` is refused).
-const SUPPORTED_EXTENSIONS: [&str; 7] = [
+const SUPPORTED_EXTENSIONS: [&str; 8] = [
     "KHR_lights_punctual",
+    "KHR_materials_clearcoat",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
     "KHR_materials_specular",

@@ -14,7 +14,7 @@ use crate::{Conductor, Lobes, Material, MetalRough, Model, TextureRef};
 
 /// Every model-specific key with the model it belongs to, and whether `m` gives it (`ior`
 /// belongs to both models and is not listed).
-fn model_keys(m: &MaterialDesc) -> [(ModelDesc, &'static str, bool); 13] {
+fn model_keys(m: &MaterialDesc) -> [(ModelDesc, &'static str, bool); 15] {
     use ModelDesc::{Lobes, MetalRough};
     [
         (Lobes, "preset", m.preset.is_some()),
@@ -34,6 +34,12 @@ fn model_keys(m: &MaterialDesc) -> [(ModelDesc, &'static str, bool); 13] {
         (MetalRough, "transmission", m.transmission.is_some()),
         (MetalRough, "specular", m.specular.is_some()),
         (MetalRough, "specular_color", m.specular_color.is_some()),
+        (MetalRough, "clearcoat", m.clearcoat.is_some()),
+        (
+            MetalRough,
+            "clearcoat_roughness",
+            m.clearcoat_roughness.is_some(),
+        ),
     ]
 }
 
@@ -210,6 +216,12 @@ impl Builder<'_, '_> {
                 m.transmission.unwrap_or(0.0),
             )?,
             specular: self.unit(span.clone(), &key("specular"), m.specular.unwrap_or(1.0))?,
+            clearcoat: self.unit(span.clone(), &key("clearcoat"), m.clearcoat.unwrap_or(0.0))?,
+            clearcoat_roughness: self.unit(
+                span.clone(),
+                &key("clearcoat_roughness"),
+                m.clearcoat_roughness.unwrap_or(0.0),
+            )?,
             specular_color: match m.specular_color {
                 Some(c) => self.radiance(span, &key("specular_color"), c)?,
                 None => Vec3::ONE,
