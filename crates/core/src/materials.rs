@@ -149,7 +149,7 @@ fn lobes_block(l: &Lobes) -> Vec<[f32; 4]> {
 
 /// The metal-rough model's block (WGSL `metal_rough_params`, CPU `MetalRoughParams::decode`):
 /// `[metallic, roughness, transmission, ior]`, `[thin (1 or 0), specular, clearcoat,
-/// clearcoat roughness]`, `[specular colour, 0]`. Its one texture
+/// clearcoat roughness]`, `[specular colour, 0]`, `[attenuation, 0]`. Its one texture
 /// is slot [`TEXTURE_MODEL`](crate::gpu_types::TEXTURE_MODEL): metallic in blue, roughness
 /// in green.
 fn metal_rough_block(m: &MetalRough) -> Vec<[f32; 4]> {
@@ -162,5 +162,6 @@ fn metal_rough_block(m: &MetalRough) -> Vec<[f32; 4]> {
             m.clearcoat_roughness,
         ],
         m.specular_color.extend(0.0).to_array(),
+        m.attenuation.extend(0.0).to_array(),
     ]
 }

@@ -12,7 +12,8 @@ use crate::intersect::Ray;
 use crate::light_sample::LightSample;
 use crate::lights::{light_pdf, sample_light};
 use crate::material::{
-    eval_material, has_continuous_material_lobe, material_albedo, material_at, sample_material,
+    eval_material, has_continuous_material_lobe, material_absorption, material_albedo, material_at,
+    sample_material,
 };
 use crate::sampler::{Draw, Sampler};
 use crate::sampling::power_heuristic;
@@ -170,6 +171,13 @@ impl Path {
         let s = surface_at(scene, &hit, &ray);
         let material = &material_at(scene, s.material, s.uv);
         let wo = -Vec3A::from(ray.dir);
+        if wo.dot(s.ng) < 0.0 {
+            // The segment ran inside the object it leaves: Beer-Lambert.
+            let absorption = material_absorption(material);
+            if absorption.max_element() > 0.0 {
+                self.throughput *= (-absorption * hit.t).exp();
+            }
+        }
         let emission = material.emission;
         if wo.dot(s.ng) > 0.0 && emission.max_element() > 0.0 {
             let object = &scene.objects[hit.object as usize];

@@ -141,6 +141,20 @@ pub fn material_albedo(p: &MaterialPoint) -> Vec3A {
     }
 }
 
+/// What the inside of a solid material absorbs per unit length (zero for every other):
+/// a path that reaches it from inside keeps `exp(-absorption t)` of its segment of length
+/// `t`. Twin of WGSL `material_absorption`.
+#[inline(always)]
+pub fn material_absorption(p: &MaterialPoint) -> Vec3A {
+    match p.model {
+        MODEL_METAL_ROUGH => {
+            let m = MetalRoughParams::decode(&p.params);
+            if m.thin { Vec3A::ZERO } else { m.attenuation }
+        }
+        _ => Vec3A::ZERO,
+    }
+}
+
 /// Whether the BSDF has a non-delta lobe (next-event estimation is worth doing). Twin of
 /// WGSL `has_continuous_material_lobe`.
 #[inline(always)]

@@ -68,6 +68,8 @@ pub struct MetalRoughParams {
     pub clearcoat: f32,
     /// The coat's perceptual roughness.
     pub clearcoat_roughness: f32,
+    /// Absorption coefficient per unit length inside a solid material.
+    pub attenuation: Vec3A,
 }
 
 impl MetalRoughParams {
@@ -84,6 +86,7 @@ impl MetalRoughParams {
             specular_color: Vec3A::new(p[2].x, p[2].y, p[2].z),
             clearcoat: p[1].z,
             clearcoat_roughness: p[1].w,
+            attenuation: Vec3A::new(p[3].x, p[3].y, p[3].z),
         }
     }
 }

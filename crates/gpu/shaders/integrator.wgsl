@@ -175,6 +175,13 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> PathResult {
         let s = surface_at(hit, ray);
         let material = material_at(s.material, s.uv);
         let wo = -ray.dir;
+        if dot(wo, s.ng) < 0.0 {
+            // The segment ran inside the object it leaves: Beer-Lambert.
+            let absorption = material_absorption(material);
+            if max(max(absorption.x, absorption.y), absorption.z) > 0.0 {
+                throughput *= exp(-absorption * hit.t);
+            }
+        }
         if dot(wo, s.ng) > 0.0 && max(max(material.emission.x, material.emission.y), material.emission.z) > 0.0 {
             var w = 1.0;
             if !prev_delta && objects[hit.object].light != NO_LIGHT {

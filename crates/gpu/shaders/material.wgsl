@@ -98,6 +98,21 @@ fn material_albedo(p: MaterialPoint) -> vec3f {
     }
 }
 
+// What the inside of a solid material absorbs per unit length (zero for every other): a
+// path that reaches it from inside keeps exp(-absorption t) of its segment of length t.
+// CPU twin: `material_absorption`.
+fn material_absorption(p: MaterialPoint) -> vec3f {
+    switch p.model {
+        case MODEL_METAL_ROUGH: {
+            let m = metal_rough_params(p.params);
+            return select(m.attenuation, vec3f(0.0), m.thin);
+        }
+        default: {
+            return vec3f(0.0);
+        }
+    }
+}
+
 // Whether the BSDF has a non-delta lobe (next-event estimation is worth doing).
 // CPU twin: `has_continuous_material_lobe`.
 fn has_continuous_material_lobe(p: MaterialPoint) -> bool {

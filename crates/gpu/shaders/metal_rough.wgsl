@@ -30,12 +30,14 @@ struct MetalRoughParams {
     clearcoat: f32,
     // The coat's perceptual roughness.
     clearcoat_roughness: f32,
+    // Absorption coefficient per unit length inside a solid material.
+    attenuation: vec3f,
 }
 
 // The parameters in block `p` (a `MaterialPoint`'s `params`).
 // CPU twin: `MetalRoughParams::decode`.
 fn metal_rough_params(p: array<vec4f, MODEL_PARAMS>) -> MetalRoughParams {
-    return MetalRoughParams(p[0].x, p[0].y, p[0].z, p[0].w, p[1].x != 0.0, p[1].y, p[2].xyz, p[1].z, p[1].w);
+    return MetalRoughParams(p[0].x, p[0].y, p[0].z, p[0].w, p[1].x != 0.0, p[1].y, p[2].xyz, p[1].z, p[1].w, p[3].xyz);
 }
 
 // The model's texture step on block `p`: metallic times the blue and roughness times the

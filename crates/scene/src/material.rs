@@ -287,6 +287,10 @@ pub struct MetalRough {
     pub clearcoat: f32,
     /// The coat's perceptual roughness (`clearcoatRoughnessFactor`).
     pub clearcoat_roughness: f32,
+    /// Absorption coefficient per unit length (linear RGB) inside a solid (not `thin`)
+    /// material: light crossing it keeps `exp(-attenuation d)` over a distance d
+    /// (`KHR_materials_volume`'s `-ln(attenuationColor) / attenuationDistance`); zero: clear.
+    pub attenuation: Vec3,
 }
 
 impl MetalRough {
@@ -303,5 +307,6 @@ impl MetalRough {
         specular_color: Vec3::ONE,
         clearcoat: 0.0,
         clearcoat_roughness: 0.0,
+        attenuation: Vec3::ZERO,
     };
 }

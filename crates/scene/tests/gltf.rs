@@ -553,7 +553,7 @@ fn bad_punctual_lights_are_refused_naming_the_node() {
 }
 
 #[test]
-fn specular_and_clearcoat_factors_are_read() {
+fn specular_clearcoat_and_volume_factors_are_read() {
     let dir = tempfile::tempdir().unwrap();
     let text = std::fs::read_to_string(data("PunctualLights/lights.gltf"))
         .unwrap()
@@ -561,13 +561,16 @@ fn specular_and_clearcoat_factors_are_read() {
             r#""pbrMetallicRoughness": {"#,
             r#""extensions": {"KHR_materials_specular": {"specularFactor": 0.3,
                 "specularColorFactor": [1, 0.5, 0.25]}, "KHR_materials_clearcoat":
-                {"clearcoatFactor": 0.7, "clearcoatRoughnessFactor": 0.2}},
+                {"clearcoatFactor": 0.7, "clearcoatRoughnessFactor": 0.2},
+                "KHR_materials_volume": {"thicknessFactor": 1, "attenuationDistance": 2,
+                "attenuationColor": [0.5, 1, 0]}},
                 "pbrMetallicRoughness": {"#,
             1,
         )
         .replace(
             r#""extensionsUsed": ["#,
-            r#""extensionsUsed": ["KHR_materials_specular", "KHR_materials_clearcoat", "#,
+            r#""extensionsUsed": ["KHR_materials_specular", "KHR_materials_clearcoat",
+                "KHR_materials_volume", "#,
         );
     let path = dir.path().join("specular.gltf");
     std::fs::write(&path, text).unwrap();
@@ -578,6 +581,14 @@ fn specular_and_clearcoat_factors_are_read() {
     assert_eq!(m.specular, 0.3);
     assert_eq!(m.specular_color, Vec3::new(1.0, 0.5, 0.25));
     assert_eq!((m.clearcoat, m.clearcoat_roughness), (0.7, 0.2));
+    // Beer-Lambert from the volume: -ln(colour) / distance, a black channel absorbing all.
+    assert!(!m.thin);
+    assert!(
+        (m.attenuation.x - 2f32.ln() / 2.0).abs() < 1e-6,
+        "{}",
+        m.attenuation
+    );
+    assert_eq!((m.attenuation.y, m.attenuation.z), (0.0, 1e30));
     // Without the extension: glTF's plain dielectric.
     let plain = gltf_scene(&data("PunctualLights/lights.gltf"), None).unwrap();
     let Model::MetalRough(m) = &plain.materials[0].model else {
@@ -585,4 +596,5 @@ fn specular_and_clearcoat_factors_are_read() {
     };
     assert_eq!((m.specular, m.specular_color), (1.0, Vec3::ONE));
     assert_eq!((m.clearcoat, m.clearcoat_roughness), (0.0, 0.0));
+    assert_eq!(m.attenuation, Vec3::ZERO);
 }

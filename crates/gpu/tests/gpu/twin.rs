@@ -59,7 +59,7 @@ fn gpu_and_cpu_render_the_same_image() {
 /// The lights reference scene with every light made soft: the point light a sphere, the
 /// spot's edge smooth (and its light from a sphere too), the sun a disk of 5 degrees; and
 /// its white sphere a glTF dielectric with a coloured `KHR_materials_specular`, its blue one
-/// under a clear coat.
+/// under a clear coat, its gold one solid glass that absorbs (`KHR_materials_volume`).
 fn soft_lights() -> Scene {
     let mut s = scene("refs/lights.toml", 40, 4, 2);
     let white = s.materials.iter_mut().find(|m| m.name == "white").unwrap();
@@ -67,6 +67,14 @@ fn soft_lights() -> Scene {
         roughness: 0.4,
         specular: 0.6,
         specular_color: Vec3::new(1.0, 0.5, 2.0),
+        ..MetalRough::DEFAULT
+    });
+    let gold = s.materials.iter_mut().find(|m| m.name == "gold").unwrap();
+    gold.model = Model::MetalRough(MetalRough {
+        roughness: 0.1,
+        transmission: 1.0,
+        thin: false,
+        attenuation: Vec3::new(0.3, 1.0, 3.0),
         ..MetalRough::DEFAULT
     });
     let blue = s.materials.iter_mut().find(|m| m.name == "blue").unwrap();

@@ -115,14 +115,18 @@ impl Materials {
         }
         let volume = material.volume();
         let thickness = volume.as_ref().map_or(0.0, |v| v.thickness_factor());
-        if volume.as_ref().is_some_and(|v| {
-            v.attenuation_distance().is_finite() && v.attenuation_color() != [1.0; 3]
-        }) {
-            log::warn!(
-                "{}: {element}: the volume's attenuation (attenuationColor, attenuationDistance) is ignored: it is clear",
-                files.path.display()
-            );
-        }
+        // Beer-Lambert: -ln(colour) / distance per channel (a black channel absorbs all, a
+        // colour above 1 is clamped to 1, an infinite distance absorbs nothing).
+        let attenuation = volume.as_ref().map_or(Vec3::ZERO, |v| {
+            let distance = v.attenuation_distance();
+            Vec3::from(v.attenuation_color()).map(|c| {
+                if distance.is_finite() && distance > 0.0 && c < 1.0 {
+                    (-c.max(0.0).ln() / distance).min(1e30)
+                } else {
+                    0.0
+                }
+            })
+        });
         let alpha = match material.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
             gltf::material::AlphaMode::Mask => {
@@ -143,6 +147,7 @@ impl Materials {
                 .map_or(Vec3::ONE, |s| Vec3::from(s.specular_color_factor())),
             clearcoat,
             clearcoat_roughness,
+            attenuation,
         };
         let numbers = [
             r,
