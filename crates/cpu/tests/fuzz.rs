@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 use pathlight_core::{PreparedScene, Renderer};
 use pathlight_cpu::CpuRenderer;
-use pathlight_scene::{SceneSource, load_scene};
+use pathlight_scene::{Scene, SceneSource, load_scene};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
@@ -161,13 +161,18 @@ fn run_case(text: &str, obj: Option<(&str, &str)>, texture: &[u8]) -> Result<(),
     if let Some((name, obj)) = obj {
         embedded.push((name, obj.as_bytes()));
     }
-    let mut scene = load_scene(&SceneSource {
+    let scene = load_scene(&SceneSource {
         name: "fuzz case".into(),
         text,
         base_dir: Default::default(),
         embedded: &embedded,
     })
     .map_err(|e| e.to_string())?;
+    render_tiny(scene)
+}
+
+/// Prepares and renders `scene` at 4x4, 1 spp (`max_depth` at most 6); `Err` is a refusal.
+fn render_tiny(mut scene: Scene) -> Result<(), String> {
     scene.camera.width = 4;
     scene.camera.height = 4;
     scene.settings.max_depth = scene.settings.max_depth.min(6);
