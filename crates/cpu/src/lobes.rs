@@ -18,7 +18,7 @@ use glam::{Vec2, Vec3A, Vec4};
 use crate::material::MODEL_PARAMS;
 use crate::microfacet::{
     ALPHA_MIN, BsdfEval, BsdfSample, INVALID, continuous_sample, eval_rough_dielectric,
-    fresnel_conductor, ggx_d, ggx_g1, ggx_sample_visible, rough_dielectric_direction,
+    fresnel_conductor, ggx_d, ggx_g1, ggx_reflection, rough_dielectric_direction,
     sample_smooth_dielectric,
 };
 use crate::sampling::{Frame, sample_cosine_hemisphere};
@@ -176,13 +176,10 @@ pub fn sample_lobes(
             };
         }
         let frame = Frame::around(n);
-        let wo_l = frame.to_local(wo);
-        let h = ggx_sample_visible(wo_l, alpha, u);
-        let wi_l = 2.0 * wo_l.dot(h) * h - wo_l;
-        if wi_l.z <= 0.0 {
-            return INVALID;
-        }
-        return lobes_sample(m, color, s, wo, frame.to_world(wi_l));
+        return match ggx_reflection(&frame, frame.to_local(wo), alpha, u) {
+            Some(wi) => lobes_sample(m, color, s, wo, wi),
+            None => INVALID,
+        };
     }
     if u_lobe < weights.y + weights.z {
         let alpha = m.refract_roughness * m.refract_roughness;

@@ -38,8 +38,8 @@ use crate::cpu_scene::CpuScene;
 use crate::material::MODEL_PARAMS;
 use crate::microfacet::{
     ALPHA_MIN, BsdfEval, BsdfSample, INVALID, continuous_sample, eval_rough_dielectric,
-    fresnel_dielectric, ggx_d, ggx_g1, ggx_sample_visible, rough_dielectric_direction,
-    sample_smooth_dielectric,
+    fresnel_dielectric, ggx_d, ggx_g1, ggx_reflection, ggx_sample_visible,
+    rough_dielectric_direction, sample_smooth_dielectric,
 };
 use crate::sampling::{Frame, sample_cosine_hemisphere};
 use crate::surface::Surface;
@@ -328,13 +328,10 @@ pub fn sample(
             return delta(wi, Vec3A::ONE, wi.dot(ng) > 0.0);
         }
         let frame = Frame::around(n);
-        let wo_l = frame.to_local(wo);
-        let h = ggx_sample_visible(wo_l, alpha, u);
-        let wi_l = 2.0 * wo_l.dot(h) * h - wo_l;
-        if wi_l.z <= 0.0 {
-            return INVALID;
-        }
-        return mixture_sample(m, color, s, wo, frame.to_world(wi_l));
+        return match ggx_reflection(&frame, frame.to_local(wo), alpha, u) {
+            Some(wi) => mixture_sample(m, color, s, wo, wi),
+            None => INVALID,
+        };
     }
     // The material under the coat, from what is left of u_lobe.
     let u_lobe = (u_lobe - coat) / (1.0 - coat);
@@ -351,12 +348,10 @@ pub fn sample(
             }
             return delta(wi, schlick(l.spec_f0, l.spec_f90, cos_o) / probs.x, true);
         }
-        let h = ggx_sample_visible(wo_l, alpha, u);
-        let wi_l = 2.0 * wo_l.dot(h) * h - wo_l;
-        if wi_l.z <= 0.0 {
-            return INVALID;
-        }
-        return mixture_sample(m, color, s, wo, frame.to_world(wi_l));
+        return match ggx_reflection(&frame, wo_l, alpha, u) {
+            Some(wi) => mixture_sample(m, color, s, wo, wi),
+            None => INVALID,
+        };
     }
     if u_lobe < probs.x + probs.z {
         if m.thin {

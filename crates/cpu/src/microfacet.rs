@@ -127,6 +127,16 @@ pub fn ggx_sample_visible(wo: Vec3A, alpha: f32, u: Vec2) -> Vec3A {
     Vec3A::new(alpha * nh.x, alpha * nh.y, nh.z.max(1e-7)).normalize()
 }
 
+/// The reflection of `wo_l` (local to `frame`) about a GGX normal of `alpha` visible from
+/// it, in world space; `None` when it points below the surface. Twin of WGSL
+/// `ggx_reflection`.
+#[inline(always)]
+pub fn ggx_reflection(frame: &Frame, wo_l: Vec3A, alpha: f32, u: Vec2) -> Option<Vec3A> {
+    let h = ggx_sample_visible(wo_l, alpha, u);
+    let wi_l = 2.0 * wo_l.dot(h) * h - wo_l;
+    (wi_l.z > 0.0).then(|| frame.to_world(wi_l))
+}
+
 /// Density of `ggx_sample_visible` producing `m`. Twin of WGSL `ggx_pdf_visible`.
 #[inline(always)]
 pub fn ggx_pdf_visible(wo: Vec3A, m: Vec3A, alpha: f32) -> f32 {

@@ -111,13 +111,11 @@ fn sample_lobes(m: LobesParams, color: vec3f, s: Surface, wo: vec3f, u_lobe: f32
             return BsdfSample(wi, specular_reflectance(m, color, cos_o), 0.0, true, 1.0, true);
         }
         let frame = frame_around(n);
-        let wo_l = to_local(frame, wo);
-        let h = ggx_sample_visible(wo_l, alpha, u);
-        let wi_l = 2.0 * dot(wo_l, h) * h - wo_l;
-        if wi_l.z <= 0.0 {
+        let r = ggx_reflection(frame, to_local(frame, wo), alpha, u);
+        if !r.valid {
             return invalid_sample();
         }
-        return lobes_sample(m, color, s, wo, frame * wi_l);
+        return lobes_sample(m, color, s, wo, r.wi);
     }
     if u_lobe < weights.y + weights.z {
         let alpha = m.refract_roughness * m.refract_roughness;

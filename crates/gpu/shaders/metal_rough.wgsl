@@ -225,13 +225,11 @@ fn sample_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, 
             return BsdfSample(wi, vec3f(1.0), 0.0, true, 1.0, dot(wi, ng) > 0.0);
         }
         let frame_c = frame_around(n);
-        let h = ggx_sample_visible(to_local(frame_c, wo), alpha_c, u);
-        let wo_c = to_local(frame_c, wo);
-        let wi_l = 2.0 * dot(wo_c, h) * h - wo_c;
-        if wi_l.z <= 0.0 {
+        let r = ggx_reflection(frame_c, to_local(frame_c, wo), alpha_c, u);
+        if !r.valid {
             return invalid_sample();
         }
-        return mr_mixture_sample(m, color, s, wo, frame_c * wi_l);
+        return mr_mixture_sample(m, color, s, wo, r.wi);
     }
     // The material under the coat, from what is left of u_lobe.
     let u_base = (u_lobe - coat) / (1.0 - coat);
@@ -248,12 +246,11 @@ fn sample_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, 
             }
             return BsdfSample(wi, schlick(l.spec_f0, l.spec_f90, cos_o) / probs.x, 0.0, true, 1.0, true);
         }
-        let h = ggx_sample_visible(wo_l, alpha, u);
-        let wi_l = 2.0 * dot(wo_l, h) * h - wo_l;
-        if wi_l.z <= 0.0 {
+        let r = ggx_reflection(frame, wo_l, alpha, u);
+        if !r.valid {
             return invalid_sample();
         }
-        return mr_mixture_sample(m, color, s, wo, frame * wi_l);
+        return mr_mixture_sample(m, color, s, wo, r.wi);
     }
     if u_base < probs.x + probs.z {
         if m.thin {

@@ -86,6 +86,21 @@ fn ggx_g1(w: vec3f, alpha: f32) -> f32 {
     return 2.0 / (1.0 + sqrt(1.0 + alpha * alpha * tan2));
 }
 
+// What `ggx_reflection` returns (the CPU's returns an Option).
+struct GgxReflection {
+    wi: vec3f,
+    valid: bool,
+}
+
+// The reflection of `wo_l` (local to `frame`) about a GGX normal of `alpha` visible from
+// it, in world space; not valid when it points below the surface.
+// CPU twin: `ggx_reflection`.
+fn ggx_reflection(frame: mat3x3f, wo_l: vec3f, alpha: f32, u: vec2f) -> GgxReflection {
+    let h = ggx_sample_visible(wo_l, alpha, u);
+    let wi_l = 2.0 * dot(wo_l, h) * h - wo_l;
+    return GgxReflection(frame * wi_l, wi_l.z > 0.0);
+}
+
 // CPU twin: `ggx_sample_visible`.
 fn ggx_sample_visible(wo: vec3f, alpha: f32, u: vec2f) -> vec3f {
     let w = select(wo, -wo, wo.z < 0.0);
