@@ -172,6 +172,10 @@ const _: () = assert!(size_of::<GpuPrimitive>() == 48);
 pub const MATERIAL_MASK: u32 = 1;
 /// [`GpuMaterial::flags`] bit: alpha is the probability that a ray stops.
 pub const MATERIAL_BLEND: u32 = 2;
+/// [`GpuMaterial::flags`] bit: the model's block has its last, rarely used vector (of
+/// `MODEL_PARAMS` in `crate::materials`; the metal-rough model's sheen), which the kernels
+/// load only for materials with this bit.
+pub const MATERIAL_LONG_BLOCK: u32 = 4;
 /// A material's texture `TEXTURE_*` is slot `textures + TEXTURE_*` of the texture slots,
 /// present when bit `TEXTURE_*` of `texture_mask` is set: the base colour (sRGB; alpha in
 /// its fourth channel).
@@ -183,6 +187,20 @@ pub const TEXTURE_EMISSION: u32 = 2;
 /// [`TEXTURE_BASE`]'s kin: the model's own textures, from this index on, in the order its
 /// kernel file names them.
 pub const TEXTURE_MODEL: u32 = 3;
+/// The metal-rough model's `KHR_materials_transmission` texture (red: transmission).
+pub const TEXTURE_TRANSMISSION: u32 = TEXTURE_MODEL + 1;
+/// ... `KHR_materials_specular`'s strength texture (alpha).
+pub const TEXTURE_SPECULAR: u32 = TEXTURE_MODEL + 2;
+/// ... `KHR_materials_specular`'s colour texture (sRGB).
+pub const TEXTURE_SPECULAR_COLOR: u32 = TEXTURE_MODEL + 3;
+/// ... `KHR_materials_clearcoat`'s strength texture (red).
+pub const TEXTURE_CLEARCOAT: u32 = TEXTURE_MODEL + 4;
+/// ... `KHR_materials_clearcoat`'s roughness texture (green).
+pub const TEXTURE_CLEARCOAT_ROUGHNESS: u32 = TEXTURE_MODEL + 5;
+/// ... `KHR_materials_sheen`'s colour texture (sRGB).
+pub const TEXTURE_SHEEN_COLOR: u32 = TEXTURE_MODEL + 6;
+/// ... `KHR_materials_sheen`'s roughness texture (alpha).
+pub const TEXTURE_SHEEN_ROUGHNESS: u32 = TEXTURE_MODEL + 7;
 
 /// [`GpuTextureSlot::wrap`] mode (2 bits per axis, u in the low bits): tile.
 pub const WRAP_REPEAT: u32 = 0;

@@ -18,6 +18,7 @@ pub mod params;
 pub mod prepared;
 pub mod renderer;
 pub mod shading;
+pub mod sheen_table;
 pub mod state;
 pub mod textures;
 pub mod tonemap;

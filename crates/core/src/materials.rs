@@ -10,9 +10,10 @@ use glam::Vec3;
 use pathlight_scene::{AlphaMode, Conductor, Lobes, Material, MetalRough, Model, TextureRef, Wrap};
 
 use crate::gpu_types::{
-    GpuMaterial, GpuTextureSlot, MATERIAL_BLEND, MATERIAL_MASK, WRAP_CLAMP, WRAP_MIRROR,
-    WRAP_REPEAT,
+    GpuMaterial, GpuTextureSlot, MATERIAL_BLEND, MATERIAL_LONG_BLOCK, MATERIAL_MASK, WRAP_CLAMP,
+    WRAP_MIRROR, WRAP_REPEAT,
 };
+use crate::sheen_table::SHEEN_ALBEDO;
 use crate::textures::Textures;
 
 /// [`GpuMaterial::model`]: the seed's lobe mixture (`lobes.wgsl`).
@@ -20,17 +21,28 @@ pub const MODEL_LOBES: u32 = 0;
 /// [`GpuMaterial::model`]: glTF's metal-rough model (`metal_rough.wgsl`).
 pub const MODEL_METAL_ROUGH: u32 = 1;
 
-/// Vectors of parameters the kernels load for every material: the largest block of any
-/// model (WGSL `MODEL_PARAMS`). The buffer ends with this many zero vectors, so that a load
-/// past a short block stays inside it.
-pub const MODEL_PARAMS: usize = 4;
+/// Vectors of a model's parameter block: the largest block of any model (WGSL
+/// `MODEL_PARAMS`). The kernels load the first [`MODEL_PARAMS_SHORT`] for every material,
+/// the last only for materials flagged [`MATERIAL_LONG_BLOCK`]. The buffer ends with this
+/// many zero vectors, so that a load past a short block stays inside it.
+pub const MODEL_PARAMS: usize = 5;
+/// The vectors loaded for every material (WGSL `MODEL_PARAMS_SHORT`).
+pub const MODEL_PARAMS_SHORT: usize = 4;
+
+/// Where the parameter buffer holds the sheen albedo table
+/// ([`SHEEN_ALBEDO`](crate::sheen_table::SHEEN_ALBEDO), four entries a vector), ahead of
+/// every material's block (WGSL `SHEEN_TABLE`).
+pub const SHEEN_TABLE: u32 = 0;
+/// Vectors the sheen albedo table fills.
+pub const SHEEN_TABLE_VECTORS: usize = SHEEN_ALBEDO.len() / 4;
 
 /// The materials of a scene in the kernels' form.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PackedMaterials {
     /// Common parts, in the scene's order. Never empty.
     pub materials: Vec<GpuMaterial>,
-    /// Every model's parameter blocks, then [`MODEL_PARAMS`] zero vectors.
+    /// The sheen albedo table, every model's parameter blocks, then [`MODEL_PARAMS`] zero
+    /// vectors.
     pub params: Vec<[f32; 4]>,
     /// Per material, its textures' slots ([`GpuMaterial::textures`] onwards). Never empty.
     pub texture_slots: Vec<GpuTextureSlot>,
@@ -41,7 +53,10 @@ impl PackedMaterials {
     pub fn build(materials: &[Material], textures: &Textures) -> Self {
         let mut out = Self {
             materials: Vec::with_capacity(materials.len().max(1)),
-            params: Vec::new(),
+            params: SHEEN_ALBEDO
+                .chunks_exact(4)
+                .map(|c| [c[0], c[1], c[2], c[3]])
+                .collect(),
             texture_slots: Vec::new(),
         };
         for m in materials {
@@ -78,17 +93,28 @@ impl PackedMaterials {
             Model::MetalRough(pbr) => (
                 MODEL_METAL_ROUGH,
                 metal_rough_block(pbr),
-                vec![pbr.metal_rough_texture],
+                [pbr.metal_rough_texture]
+                    .into_iter()
+                    .chain(pbr.textures.in_slot_order())
+                    .collect(),
             ),
         };
         debug_assert!(block.len() <= MODEL_PARAMS);
+        if block.len() > MODEL_PARAMS_SHORT {
+            gpu.flags |= MATERIAL_LONG_BLOCK;
+        }
         gpu.model = model;
         self.params.extend(block);
         gpu.textures = self.texture_slots.len() as u32;
-        let uses = [m.texture, m.normal_texture, m.emission_texture]
+        let mut uses: Vec<Option<TextureRef>> = [m.texture, m.normal_texture, m.emission_texture]
             .into_iter()
-            .chain(model_textures);
-        for (i, r) in uses.enumerate() {
+            .chain(model_textures)
+            .collect();
+        // Slots past the last texture the material has are never read.
+        while uses.last().is_some_and(Option::is_none) {
+            uses.pop();
+        }
+        for (i, r) in uses.iter().enumerate() {
             if r.is_some() {
                 gpu.texture_mask |= 1 << i;
             }
@@ -149,11 +175,12 @@ fn lobes_block(l: &Lobes) -> Vec<[f32; 4]> {
 
 /// The metal-rough model's block (WGSL `metal_rough_params`, CPU `MetalRoughParams::decode`):
 /// `[metallic, roughness, transmission, ior]`, `[thin (1 or 0), specular, clearcoat,
-/// clearcoat roughness]`, `[specular colour, 0]`, `[attenuation, 0]`. Its one texture
-/// is slot [`TEXTURE_MODEL`](crate::gpu_types::TEXTURE_MODEL): metallic in blue, roughness
-/// in green.
+/// clearcoat roughness]`, `[specular colour, 0]`, `[attenuation, 0]`, and with a sheen,
+/// `[sheen colour, sheen roughness]`. Its textures are slot
+/// [`TEXTURE_MODEL`](crate::gpu_types::TEXTURE_MODEL) (metallic in blue, roughness in
+/// green) and the extensions' from `TEXTURE_TRANSMISSION` on.
 fn metal_rough_block(m: &MetalRough) -> Vec<[f32; 4]> {
-    vec![
+    let mut block = vec![
         [m.metallic, m.roughness, m.transmission, m.ior],
         [
             f32::from(u8::from(m.thin)),
@@ -163,5 +190,9 @@ fn metal_rough_block(m: &MetalRough) -> Vec<[f32; 4]> {
         ],
         m.specular_color.extend(0.0).to_array(),
         m.attenuation.extend(0.0).to_array(),
-    ]
+    ];
+    if m.sheen_color.max_element() > 0.0 {
+        block.push(m.sheen_color.extend(m.sheen_roughness).to_array());
+    }
+    block
 }

@@ -24,6 +24,7 @@ pub mod point_light;
 mod row;
 pub mod sampler;
 pub mod sampling;
+pub mod sheen;
 pub mod sun_light;
 pub mod surface;
 pub mod textures;

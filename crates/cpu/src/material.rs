@@ -4,7 +4,7 @@
 //! `material.wgsl`.
 
 use glam::{Vec2, Vec3A, Vec4};
-use pathlight_core::gpu_types::{GpuMaterial, TEXTURE_BASE, TEXTURE_EMISSION};
+use pathlight_core::gpu_types::{GpuMaterial, MATERIAL_LONG_BLOCK, TEXTURE_BASE, TEXTURE_EMISSION};
 use pathlight_core::materials::MODEL_METAL_ROUGH;
 
 use crate::cpu_scene::CpuScene;
@@ -16,10 +16,10 @@ use crate::microfacet::{BsdfEval, BsdfSample};
 use crate::surface::Surface;
 use crate::textures::{has_texture, material_texture, srgb_to_linear};
 
-/// Vectors of a model's parameter block the kernels load (WGSL `MODEL_PARAMS`; `material_at`
-/// loads them one by one).
+/// Vectors of a model's parameter block (WGSL `MODEL_PARAMS`; `material_at` loads them one
+/// by one, the last only for a material flagged `MATERIAL_LONG_BLOCK`).
 pub const MODEL_PARAMS: usize = pathlight_core::materials::MODEL_PARAMS;
-const _: () = assert!(MODEL_PARAMS == 4);
+const _: () = assert!(MODEL_PARAMS == 5 && pathlight_core::materials::MODEL_PARAMS_SHORT == 4);
 
 /// A material with its textures applied at a point: what its model's BSDF reads. Twin of
 /// WGSL `MaterialPoint`.
@@ -46,7 +46,11 @@ pub fn material_at(scene: &CpuScene, index: u32, uv: Vec2) -> MaterialPoint {
         Vec4::from_array(block[1]),
         Vec4::from_array(block[2]),
         Vec4::from_array(block[3]),
+        Vec4::ZERO,
     ];
+    if m.flags & MATERIAL_LONG_BLOCK != 0 {
+        params[4] = Vec4::from_array(block[4]);
+    }
     let mut base_color = Vec3A::from(m.base_color);
     if has_texture(m, TEXTURE_BASE) {
         let texel = material_texture(scene, m, TEXTURE_BASE, uv)

@@ -26,13 +26,22 @@
 //! Schlick's from 0.04 (ior 1.5) at the shading normal (the coat's own normal map is not
 //! read).
 //!
+//! A sheen of colour `c_s` and roughness `r_s` (`KHR_materials_sheen`) lies between the
+//! coat and the rest: the lobe of [`crate::sheen`] tinted by `c_s`, over the rest scaled by
+//! the extension's `1 - max(c_s) E(n.wo)`, E the lobe's albedo (at most 1).
+//!
 //! Lobes are sampled in proportion to their estimated albedo at `wo`; the coat with
-//! probability `k F_c(n.wo)`, its weight.
+//! probability `k F_c(n.wo)`, its weight; then the sheen (uniformly over the hemisphere)
+//! with probability `max(c_s) E(n.wo)`.
 
-use std::f32::consts::FRAC_1_PI;
+use std::f32::consts::{FRAC_1_PI, PI};
 
 use glam::{Vec2, Vec3A, Vec4};
-use pathlight_core::gpu_types::{GpuMaterial, TEXTURE_MODEL};
+use pathlight_core::gpu_types::{
+    GpuMaterial, TEXTURE_CLEARCOAT, TEXTURE_CLEARCOAT_ROUGHNESS, TEXTURE_MODEL,
+    TEXTURE_SHEEN_COLOR, TEXTURE_SHEEN_ROUGHNESS, TEXTURE_SPECULAR, TEXTURE_SPECULAR_COLOR,
+    TEXTURE_TRANSMISSION,
+};
 
 use crate::cpu_scene::CpuScene;
 use crate::material::MODEL_PARAMS;
@@ -41,9 +50,10 @@ use crate::microfacet::{
     fresnel_dielectric, ggx_d, ggx_g1, ggx_reflection, ggx_sample_visible,
     rough_dielectric_direction, sample_smooth_dielectric,
 };
-use crate::sampling::{Frame, sample_cosine_hemisphere};
+use crate::sampling::{Frame, sample_cone, sample_cosine_hemisphere};
+use crate::sheen::{eval_sheen, sheen_reflectance};
 use crate::surface::Surface;
-use crate::textures::{has_texture, material_texture};
+use crate::textures::{has_texture, material_texture, srgb_to_linear};
 
 /// The model's parameters: its block of the material parameters, as
 /// `pathlight_core::materials` lays it out (`metal_rough_block`), with its texture
@@ -70,6 +80,10 @@ pub struct MetalRoughParams {
     pub clearcoat_roughness: f32,
     /// Absorption coefficient per unit length inside a solid material.
     pub attenuation: Vec3A,
+    /// Colour of the sheen (`KHR_materials_sheen`; black: none).
+    pub sheen_color: Vec3A,
+    /// The sheen's perceptual roughness.
+    pub sheen_roughness: f32,
 }
 
 impl MetalRoughParams {
@@ -87,12 +101,15 @@ impl MetalRoughParams {
             clearcoat: p[1].z,
             clearcoat_roughness: p[1].w,
             attenuation: Vec3A::new(p[3].x, p[3].y, p[3].z),
+            sheen_color: Vec3A::new(p[4].x, p[4].y, p[4].z),
+            sheen_roughness: p[4].w,
         }
     }
 }
 
 /// The model's texture step on block `p`: metallic times the blue and roughness times the
-/// green channel of its texture (slot [`TEXTURE_MODEL`], linear) at `uv`. Twin of WGSL
+/// green channel of its texture (slot [`TEXTURE_MODEL`], linear) at `uv`, then the
+/// extensions' textures on their factors (glTF's channels; colours sRGB). Twin of WGSL
 /// `metal_rough_textured`.
 #[inline(always)]
 pub fn metal_rough_textured(
@@ -105,6 +122,33 @@ pub fn metal_rough_textured(
         let t = material_texture(scene, m, TEXTURE_MODEL, uv);
         p[0].y *= t.y;
         p[0].x *= t.z;
+    }
+    if m.texture_mask >> TEXTURE_TRANSMISSION == 0 {
+        return;
+    }
+    let texel = |which: u32| material_texture(scene, m, which, uv);
+    if has_texture(m, TEXTURE_TRANSMISSION) {
+        p[0].z *= texel(TEXTURE_TRANSMISSION).x;
+    }
+    if has_texture(m, TEXTURE_SPECULAR) {
+        p[1].y *= texel(TEXTURE_SPECULAR).w;
+    }
+    if has_texture(m, TEXTURE_SPECULAR_COLOR) {
+        let c = srgb_to_linear(texel(TEXTURE_SPECULAR_COLOR).truncate().into());
+        p[2] *= c.extend(1.0);
+    }
+    if has_texture(m, TEXTURE_CLEARCOAT) {
+        p[1].z *= texel(TEXTURE_CLEARCOAT).x;
+    }
+    if has_texture(m, TEXTURE_CLEARCOAT_ROUGHNESS) {
+        p[1].w *= texel(TEXTURE_CLEARCOAT_ROUGHNESS).y;
+    }
+    if has_texture(m, TEXTURE_SHEEN_COLOR) {
+        let c = srgb_to_linear(texel(TEXTURE_SHEEN_COLOR).truncate().into());
+        p[4] *= c.extend(1.0);
+    }
+    if has_texture(m, TEXTURE_SHEEN_ROUGHNESS) {
+        p[4].w *= texel(TEXTURE_SHEEN_ROUGHNESS).w;
     }
 }
 
@@ -157,25 +201,37 @@ fn coupling(l: &Lobes, cos_i: f32) -> f32 {
     1.0 - l.specular * schlick(l.f0_d, 1.0, cos_i).max_element()
 }
 
+/// Estimated albedos of the specular lobe, the diffuse base and the interface at `cos_o`.
+/// Twin of WGSL `mr_lobe_albedos`.
+#[inline(always)]
+fn lobe_albedos(color: Vec3A, l: &Lobes, cos_o: f32) -> Vec3A {
+    let lum = Vec3A::new(0.2126, 0.7152, 0.0722);
+    let spec = schlick(l.spec_f0, l.spec_f90, cos_o).dot(lum);
+    let diffuse = l.diffuse * color.dot(lum) * coupling(l, cos_o);
+    Vec3A::new(spec, diffuse, l.wall)
+}
+
 /// Probabilities of sampling the specular lobe, the diffuse base and the interface. Twin
 /// of WGSL `mr_probabilities`.
 #[inline(always)]
 fn probabilities(color: Vec3A, l: &Lobes, cos_o: f32) -> Vec3A {
-    let lum = Vec3A::new(0.2126, 0.7152, 0.0722);
-    let spec = schlick(l.spec_f0, l.spec_f90, cos_o).dot(lum);
-    let diffuse = l.diffuse * color.dot(lum) * coupling(l, cos_o);
-    let total = spec + diffuse + l.wall;
+    let albedos = lobe_albedos(color, l, cos_o);
+    let total = albedos.element_sum();
     if total > 0.0 {
-        Vec3A::new(spec, diffuse, l.wall) / total
+        albedos / total
     } else {
         Vec3A::ZERO
     }
 }
 
-/// The continuous part of the BSDF: the coat over the rest. Twin of WGSL `eval_metal_rough`.
+/// The continuous part of the BSDF: the coat over the sheen over the rest. Twin of WGSL
+/// `eval_metal_rough`.
 #[inline(always)]
 pub fn eval(m: &MetalRoughParams, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3A) -> BsdfEval {
-    let base = eval_base(m, color, s, wo, wi);
+    let mut base = eval_base(m, color, s, wo, wi);
+    if m.sheen_color.max_element() > 0.0 {
+        base = sheen_over(m, color, s, wo, wi, base);
+    }
     if m.clearcoat <= 0.0 {
         return base;
     }
@@ -195,6 +251,55 @@ pub fn eval(m: &MetalRoughParams, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3
         let g1o = ggx_g1(wo_l, alpha);
         out.f += Vec3A::splat(weight * d * g1o * ggx_g1(wi_l, alpha) / (4.0 * wo_l.z));
         out.pdf += weight * g1o * d / (4.0 * wo_l.z);
+    }
+    out
+}
+
+/// The probability of sampling the sheen rather than the layer under it: its estimated
+/// albedo at `cos_o`, `max(c_s) E`, over that plus the layer's, scaled (1 without a layer
+/// to sample). Twin of WGSL `mr_sheen_probability`.
+#[inline(always)]
+fn sheen_probability(m: &MetalRoughParams, color: Vec3A, cos_o: f32) -> f32 {
+    let sheen = m.sheen_color.max_element() * sheen_reflectance(cos_o, m.sheen_roughness);
+    let under = (1.0 - sheen) * lobe_albedos(color, &lobes(m, color), cos_o).element_sum();
+    if under > 0.0 {
+        sheen / (sheen + under)
+    } else {
+        1.0
+    }
+}
+
+/// What the sheen lets through to the layer under it at `cos_o`: the extension's albedo
+/// scaling in its `VdotN` form, `1 - max(c_s) E(cos_o)`, which keeps a white sheen over a
+/// white base at albedo 1 (the reciprocal form, with `max(E(cos_o), E(cos_i))`, loses up to
+/// 10% of it). Twin of WGSL `mr_sheen_scaling`.
+#[inline(always)]
+fn sheen_scaling(m: &MetalRoughParams, cos_o: f32) -> f32 {
+    1.0 - m.sheen_color.max_element() * sheen_reflectance(cos_o, m.sheen_roughness)
+}
+
+/// The sheen over `under` (the layer below it, evaluated). Twin of WGSL `mr_sheen_over`.
+#[inline(always)]
+fn sheen_over(
+    m: &MetalRoughParams,
+    color: Vec3A,
+    s: &Surface,
+    wo: Vec3A,
+    wi: Vec3A,
+    under: BsdfEval,
+) -> BsdfEval {
+    let sign = if wo.dot(s.ng) >= 0.0 { 1.0 } else { -1.0 };
+    let (ng, n) = (s.ng * sign, s.ns * sign);
+    let (cos_o, cos_i) = (wo.dot(n), wi.dot(n));
+    let q = sheen_probability(m, color, cos_o);
+    let mut out = BsdfEval {
+        f: under.f * sheen_scaling(m, cos_o),
+        pdf: under.pdf * (1.0 - q),
+    };
+    if cos_o > 0.0 && cos_i > 0.0 && wi.dot(ng) > 0.0 {
+        let cos_h = (wo + wi).normalize().dot(n);
+        out.f += m.sheen_color * eval_sheen(m.sheen_roughness, cos_o, cos_i, cos_h);
+        out.pdf += q / (2.0 * PI);
     }
     out
 }
@@ -333,8 +438,40 @@ pub fn sample(
             None => INVALID,
         };
     }
-    // The material under the coat, from what is left of u_lobe.
+    // The material under the coat, from what is left of u_lobe: the sheen, or under it.
     let u_lobe = (u_lobe - coat) / (1.0 - coat);
+    if m.sheen_color.max_element() <= 0.0 {
+        return sample_base(m, color, s, wo, u_lobe, u_fresnel, u);
+    }
+    let q = sheen_probability(m, color, cos_o);
+    if u_lobe < q {
+        let wi = sample_cone(n, 1.0, u);
+        if wi.dot(ng) <= 0.0 {
+            return INVALID;
+        }
+        return mixture_sample(m, color, s, wo, wi);
+    }
+    let mut bs = sample_base(m, color, s, wo, (u_lobe - q) / (1.0 - q), u_fresnel, u);
+    if bs.delta {
+        bs.weight *= sheen_scaling(m, cos_o) / (1.0 - q);
+    }
+    bs
+}
+
+/// Samples the material under the coat and the sheen. Twin of WGSL `sample_metal_rough_base`.
+#[inline(always)]
+fn sample_base(
+    m: &MetalRoughParams,
+    color: Vec3A,
+    s: &Surface,
+    wo: Vec3A,
+    u_lobe: f32,
+    u_fresnel: f32,
+    u: Vec2,
+) -> BsdfSample {
+    let sign = if wo.dot(s.ng) >= 0.0 { 1.0 } else { -1.0 };
+    let (ng, n) = (s.ng * sign, s.ns * sign);
+    let cos_o = wo.dot(n);
     let l = lobes(m, color);
     let probs = probabilities(color, &l, cos_o);
     let alpha = m.roughness * m.roughness;
@@ -394,12 +531,14 @@ pub fn sample(
 }
 
 /// The albedo a denoiser reads: the specular F0, the diffuse base's colour under what the
-/// specular layer lets through at normal incidence, and the tinted wall. Twin of WGSL
-/// `metal_rough_albedo`.
+/// specular layer lets through at normal incidence, and the tinted wall, under the sheen's
+/// albedo at normal incidence. Twin of WGSL `metal_rough_albedo`.
 #[inline(always)]
 pub fn metal_rough_albedo(m: &MetalRoughParams, color: Vec3A) -> Vec3A {
     let l = lobes(m, color);
-    let base = l.spec_f0 + (l.diffuse * coupling(&l, 1.0)) * color + l.wall * color;
+    let under = l.spec_f0 + (l.diffuse * coupling(&l, 1.0)) * color + l.wall * color;
+    let sheen = sheen_reflectance(1.0, m.sheen_roughness);
+    let base = under * (1.0 - m.sheen_color.max_element() * sheen) + m.sheen_color * sheen;
     let coat = coat_weight(m, 1.0);
     base * (1.0 - coat) + Vec3A::splat(coat)
 }
@@ -410,4 +549,5 @@ pub fn has_continuous_metal_rough(m: &MetalRoughParams, color: Vec3A) -> bool {
     lobes(m, color).diffuse > 0.0
         || m.roughness * m.roughness >= ALPHA_MIN
         || (m.clearcoat > 0.0 && m.clearcoat_roughness * m.clearcoat_roughness >= ALPHA_MIN)
+        || m.sheen_color.max_element() > 0.0
 }

@@ -33,7 +33,11 @@ fn material_at(index: u32, uv: vec2f) -> MaterialPoint {
     let m = materials[index];
     // Loaded with constant indices (MODEL_PARAMS of them): an array indexed at run time
     // would be kept in memory rather than in registers.
-    var params = array<vec4f, MODEL_PARAMS>(param_blocks[m.params], param_blocks[m.params + 1u], param_blocks[m.params + 2u], param_blocks[m.params + 3u]);
+    // The last vector only for a material with a long block.
+    var params = array<vec4f, MODEL_PARAMS>(param_blocks[m.params], param_blocks[m.params + 1u], param_blocks[m.params + 2u], param_blocks[m.params + 3u], vec4f(0.0));
+    if (m.flags & MATERIAL_LONG_BLOCK) != 0u {
+        params[4] = param_blocks[m.params + 4u];
+    }
     var base_color = m.base_color;
     if has_texture(m, TEXTURE_BASE) {
         base_color = m.base_color * srgb_to_linear(material_texture(m, TEXTURE_BASE, uv).rgb);

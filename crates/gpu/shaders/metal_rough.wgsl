@@ -1,13 +1,14 @@
 // glTF 2.0's metallic-roughness material model. CPU twin: `crates/cpu/src/metal_rough.rs`,
 // whose header states the model: a mixture of a GGX specular lobe with Schlick Fresnel, a
 // diffuse base under it weighted as glTF's `fresnel_mix` and a dielectric wall
-// (transmission), weighted by metallic and transmission, under a clear coat.
+// (transmission), weighted by metallic and transmission, under a sheen, under a clear coat.
 
 #import scene
 #import textures
 #import surface
 #import sampling
 #import microfacet
+#import sheen
 
 // The model's parameters: its block in `param_blocks`, laid out by
 // `pathlight_core::materials` (`metal_rough_block`), with its texture applied.
@@ -32,22 +33,51 @@ struct MetalRoughParams {
     clearcoat_roughness: f32,
     // Absorption coefficient per unit length inside a solid material.
     attenuation: vec3f,
+    // Colour of the sheen (KHR_materials_sheen; black: none).
+    sheen_color: vec3f,
+    // The sheen's perceptual roughness.
+    sheen_roughness: f32,
 }
 
 // The parameters in block `p` (a `MaterialPoint`'s `params`).
 // CPU twin: `MetalRoughParams::decode`.
 fn metal_rough_params(p: array<vec4f, MODEL_PARAMS>) -> MetalRoughParams {
-    return MetalRoughParams(p[0].x, p[0].y, p[0].z, p[0].w, p[1].x != 0.0, p[1].y, p[2].xyz, p[1].z, p[1].w, p[3].xyz);
+    return MetalRoughParams(p[0].x, p[0].y, p[0].z, p[0].w, p[1].x != 0.0, p[1].y, p[2].xyz, p[1].z, p[1].w, p[3].xyz, p[4].xyz, p[4].w);
 }
 
 // The model's texture step on block `p`: metallic times the blue and roughness times the
-// green channel of its texture (slot TEXTURE_MODEL, linear) at `uv`.
+// green channel of its texture (slot TEXTURE_MODEL, linear) at `uv`, then the extensions'
+// textures on their factors (glTF's channels; colours sRGB).
 // CPU twin: `metal_rough_textured`.
 fn metal_rough_textured(p: ptr<function, array<vec4f, MODEL_PARAMS>>, m: Material, uv: vec2f) {
     if has_texture(m, TEXTURE_MODEL) {
         let t = material_texture(m, TEXTURE_MODEL, uv);
         (*p)[0].y *= t.g;
         (*p)[0].x *= t.b;
+    }
+    if (m.texture_mask >> TEXTURE_TRANSMISSION) == 0u {
+        return;
+    }
+    if has_texture(m, TEXTURE_TRANSMISSION) {
+        (*p)[0].z *= material_texture(m, TEXTURE_TRANSMISSION, uv).r;
+    }
+    if has_texture(m, TEXTURE_SPECULAR) {
+        (*p)[1].y *= material_texture(m, TEXTURE_SPECULAR, uv).a;
+    }
+    if has_texture(m, TEXTURE_SPECULAR_COLOR) {
+        (*p)[2] *= vec4f(srgb_to_linear(material_texture(m, TEXTURE_SPECULAR_COLOR, uv).rgb), 1.0);
+    }
+    if has_texture(m, TEXTURE_CLEARCOAT) {
+        (*p)[1].z *= material_texture(m, TEXTURE_CLEARCOAT, uv).r;
+    }
+    if has_texture(m, TEXTURE_CLEARCOAT_ROUGHNESS) {
+        (*p)[1].w *= material_texture(m, TEXTURE_CLEARCOAT_ROUGHNESS, uv).g;
+    }
+    if has_texture(m, TEXTURE_SHEEN_COLOR) {
+        (*p)[4] *= vec4f(srgb_to_linear(material_texture(m, TEXTURE_SHEEN_COLOR, uv).rgb), 1.0);
+    }
+    if has_texture(m, TEXTURE_SHEEN_ROUGHNESS) {
+        (*p)[4].w *= material_texture(m, TEXTURE_SHEEN_ROUGHNESS, uv).a;
     }
 }
 
@@ -89,23 +119,33 @@ fn mr_coupling(l: MetalRoughLobes, cos_i: f32) -> f32 {
     return 1.0 - l.specular * max(max(f.x, f.y), f.z);
 }
 
-// Probabilities of sampling the specular lobe, the diffuse base and the wall.
-// CPU twin: `probabilities`.
-fn mr_probabilities(color: vec3f, l: MetalRoughLobes, cos_o: f32) -> vec3f {
+// Estimated albedos of the specular lobe, the diffuse base and the wall at cos_o.
+// CPU twin: `lobe_albedos`.
+fn mr_lobe_albedos(color: vec3f, l: MetalRoughLobes, cos_o: f32) -> vec3f {
     let lum = vec3f(0.2126, 0.7152, 0.0722);
     let spec = dot(schlick(l.spec_f0, l.spec_f90, cos_o), lum);
     let diffuse = l.diffuse * dot(color, lum) * mr_coupling(l, cos_o);
-    let total = spec + diffuse + l.wall;
+    return vec3f(spec, diffuse, l.wall);
+}
+
+// Probabilities of sampling the specular lobe, the diffuse base and the wall.
+// CPU twin: `probabilities`.
+fn mr_probabilities(color: vec3f, l: MetalRoughLobes, cos_o: f32) -> vec3f {
+    let albedos = mr_lobe_albedos(color, l, cos_o);
+    let total = albedos.x + albedos.y + albedos.z;
     if !(total > 0.0) {
         return vec3f(0.0);
     }
-    return vec3f(spec, diffuse, l.wall) / total;
+    return albedos / total;
 }
 
-// The continuous part of the BSDF: the coat over the rest.
+// The continuous part of the BSDF: the coat over the sheen over the rest.
 // CPU twin: `eval`.
 fn eval_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, wi: vec3f) -> BsdfEval {
-    let base = eval_metal_rough_base(m, color, s, wo, wi);
+    var base = eval_metal_rough_base(m, color, s, wo, wi);
+    if max3(m.sheen_color) > 0.0 {
+        base = mr_sheen_over(m, color, s, wo, wi, base);
+    }
     if m.clearcoat <= 0.0 {
         return base;
     }
@@ -124,6 +164,50 @@ fn eval_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, wi
         let g1o = ggx_g1(wo_l, alpha);
         out.f += vec3f(weight * d * g1o * ggx_g1(wi_l, alpha) / (4.0 * wo_l.z));
         out.pdf += weight * g1o * d / (4.0 * wo_l.z);
+    }
+    return out;
+}
+
+// The largest of v's components.
+// CPU twin: `Vec3A::max_element`.
+fn max3(v: vec3f) -> f32 {
+    return max(max(v.x, v.y), v.z);
+}
+
+// The probability of sampling the sheen rather than the layer under it: its estimated
+// albedo over that plus the layer's, scaled (1 without a layer to sample).
+// CPU twin: `sheen_probability`.
+fn mr_sheen_probability(m: MetalRoughParams, color: vec3f, cos_o: f32) -> f32 {
+    let sheen = max3(m.sheen_color) * sheen_reflectance(cos_o, m.sheen_roughness);
+    let a = mr_lobe_albedos(color, mr_lobes(m, color), cos_o);
+    let under = (1.0 - sheen) * (a.x + a.y + a.z);
+    if under > 0.0 {
+        return sheen / (sheen + under);
+    }
+    return 1.0;
+}
+
+// What the sheen lets through to the layer under it at cos_o: the extension's albedo
+// scaling in its VdotN form.
+// CPU twin: `sheen_scaling`.
+fn mr_sheen_scaling(m: MetalRoughParams, cos_o: f32) -> f32 {
+    return 1.0 - max3(m.sheen_color) * sheen_reflectance(cos_o, m.sheen_roughness);
+}
+
+// The sheen over `under` (the layer below it, evaluated).
+// CPU twin: `sheen_over`.
+fn mr_sheen_over(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, wi: vec3f, under: BsdfEval) -> BsdfEval {
+    let front = dot(wo, s.ng) >= 0.0;
+    let ng = select(-s.ng, s.ng, front);
+    let n = select(-s.ns, s.ns, front);
+    let cos_o = dot(wo, n);
+    let cos_i = dot(wi, n);
+    let q = mr_sheen_probability(m, color, cos_o);
+    var out = BsdfEval(under.f * mr_sheen_scaling(m, cos_o), under.pdf * (1.0 - q));
+    if cos_o > 0.0 && cos_i > 0.0 && dot(wi, ng) > 0.0 {
+        let cos_h = dot(normalize(wo + wi), n);
+        out.f += m.sheen_color * eval_sheen(m.sheen_roughness, cos_o, cos_i, cos_h);
+        out.pdf += q / (2.0 * PI);
     }
     return out;
 }
@@ -231,8 +315,33 @@ fn sample_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, 
         }
         return mr_mixture_sample(m, color, s, wo, r.wi);
     }
-    // The material under the coat, from what is left of u_lobe.
-    let u_base = (u_lobe - coat) / (1.0 - coat);
+    // The material under the coat, from what is left of u_lobe: the sheen, or under it.
+    let u_rest = (u_lobe - coat) / (1.0 - coat);
+    if max3(m.sheen_color) <= 0.0 {
+        return sample_metal_rough_base(m, color, s, wo, u_rest, u_fresnel, u);
+    }
+    let q = mr_sheen_probability(m, color, cos_o);
+    if u_rest < q {
+        let wi = sample_cone(n, 1.0, u);
+        if dot(wi, ng) <= 0.0 {
+            return invalid_sample();
+        }
+        return mr_mixture_sample(m, color, s, wo, wi);
+    }
+    var bs = sample_metal_rough_base(m, color, s, wo, (u_rest - q) / (1.0 - q), u_fresnel, u);
+    if bs.delta {
+        bs.weight *= mr_sheen_scaling(m, cos_o) / (1.0 - q);
+    }
+    return bs;
+}
+
+// Samples the material under the coat and the sheen.
+// CPU twin: `sample_base`.
+fn sample_metal_rough_base(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, u_base: f32, u_fresnel: f32, u: vec2f) -> BsdfSample {
+    let front = dot(wo, s.ng) >= 0.0;
+    let ng = select(-s.ng, s.ng, front);
+    let n = select(-s.ns, s.ns, front);
+    let cos_o = dot(wo, n);
     let l = mr_lobes(m, color);
     let probs = mr_probabilities(color, l, cos_o);
     let alpha = m.roughness * m.roughness;
@@ -290,11 +399,14 @@ fn sample_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, 
 }
 
 // The albedo a denoiser reads: the specular F0, the diffuse base's colour under what the
-// specular layer lets through at normal incidence, and the tinted wall.
+// specular layer lets through at normal incidence, and the tinted wall, under the sheen's
+// albedo at normal incidence.
 // CPU twin: `metal_rough_albedo`.
 fn metal_rough_albedo(m: MetalRoughParams, color: vec3f) -> vec3f {
     let l = mr_lobes(m, color);
-    let base = l.spec_f0 + (l.diffuse * mr_coupling(l, 1.0)) * color + l.wall * color;
+    let under = l.spec_f0 + (l.diffuse * mr_coupling(l, 1.0)) * color + l.wall * color;
+    let sheen = sheen_reflectance(1.0, m.sheen_roughness);
+    let base = under * (1.0 - max3(m.sheen_color) * sheen) + m.sheen_color * sheen;
     let coat = mr_coat_weight(m, 1.0);
     return base * (1.0 - coat) + vec3f(coat);
 }
@@ -303,5 +415,6 @@ fn metal_rough_albedo(m: MetalRoughParams, color: vec3f) -> vec3f {
 // CPU twin: `has_continuous_metal_rough`.
 fn has_continuous_metal_rough(m: MetalRoughParams, color: vec3f) -> bool {
     return mr_lobes(m, color).diffuse > 0.0 || m.roughness * m.roughness >= ALPHA_MIN
-        || (m.clearcoat > 0.0 && m.clearcoat_roughness * m.clearcoat_roughness >= ALPHA_MIN);
+        || (m.clearcoat > 0.0 && m.clearcoat_roughness * m.clearcoat_roughness >= ALPHA_MIN)
+        || max3(m.sheen_color) > 0.0;
 }

@@ -83,14 +83,25 @@ struct Primitive {
 const NO_TRIANGLE: u32 = 0xffffffffu;
 const SHAPE_LEAF: u32 = 0x80000000u;
 
-// Vectors of a model's parameter block that the kernels load (host: `MODEL_PARAMS`).
-const MODEL_PARAMS: u32 = 4u;
+// Vectors of a model's parameter block (host: `MODEL_PARAMS`); the last is loaded only for
+// materials flagged MATERIAL_LONG_BLOCK.
+const MODEL_PARAMS: u32 = 5u;
+// Where `param_blocks` holds the sheen albedo table (host: `SHEEN_TABLE`).
+const SHEEN_TABLE: u32 = 0u;
 const MATERIAL_MASK: u32 = 1u;
 const MATERIAL_BLEND: u32 = 2u;
+const MATERIAL_LONG_BLOCK: u32 = 4u;
 const TEXTURE_BASE: u32 = 0u;
 const TEXTURE_NORMAL: u32 = 1u;
 const TEXTURE_EMISSION: u32 = 2u;
 const TEXTURE_MODEL: u32 = 3u;
+const TEXTURE_TRANSMISSION: u32 = 4u;
+const TEXTURE_SPECULAR: u32 = 5u;
+const TEXTURE_SPECULAR_COLOR: u32 = 6u;
+const TEXTURE_CLEARCOAT: u32 = 7u;
+const TEXTURE_CLEARCOAT_ROUGHNESS: u32 = 8u;
+const TEXTURE_SHEEN_COLOR: u32 = 9u;
+const TEXTURE_SHEEN_ROUGHNESS: u32 = 10u;
 const WRAP_REPEAT: u32 = 0u;
 const WRAP_CLAMP: u32 = 1u;
 const WRAP_MIRROR: u32 = 2u;
@@ -139,6 +150,6 @@ struct Material {
 @group(0) @binding(7) var<storage, read> primitives: array<Primitive>;
 // Per BVH node, its parent's index << 2 | its lane there (`pathlight_core::bvh::parents`).
 @group(0) @binding(8) var<storage, read> parents: array<u32>;
-// The parameter blocks: the materials' (`pathlight_core::materials`), then the point and
-// sun lights' (`pathlight_core::light_table`).
+// The parameter blocks: the sheen albedo table and the materials'
+// (`pathlight_core::materials`), then the point and sun lights' (`pathlight_core::light_table`).
 @group(0) @binding(11) var<storage, read> param_blocks: array<vec4f>;

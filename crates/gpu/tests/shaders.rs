@@ -262,10 +262,21 @@ fn host_constants_match_their_wgsl_declarations() {
         ("SHAPE_LEAF", t::SHAPE_LEAF),
         ("MATERIAL_MASK", t::MATERIAL_MASK),
         ("MATERIAL_BLEND", t::MATERIAL_BLEND),
+        ("MATERIAL_LONG_BLOCK", t::MATERIAL_LONG_BLOCK),
         ("TEXTURE_BASE", t::TEXTURE_BASE),
         ("TEXTURE_NORMAL", t::TEXTURE_NORMAL),
         ("TEXTURE_EMISSION", t::TEXTURE_EMISSION),
         ("TEXTURE_MODEL", t::TEXTURE_MODEL),
+        ("TEXTURE_TRANSMISSION", t::TEXTURE_TRANSMISSION),
+        ("TEXTURE_SPECULAR", t::TEXTURE_SPECULAR),
+        ("TEXTURE_SPECULAR_COLOR", t::TEXTURE_SPECULAR_COLOR),
+        ("TEXTURE_CLEARCOAT", t::TEXTURE_CLEARCOAT),
+        (
+            "TEXTURE_CLEARCOAT_ROUGHNESS",
+            t::TEXTURE_CLEARCOAT_ROUGHNESS,
+        ),
+        ("TEXTURE_SHEEN_COLOR", t::TEXTURE_SHEEN_COLOR),
+        ("TEXTURE_SHEEN_ROUGHNESS", t::TEXTURE_SHEEN_ROUGHNESS),
         ("WRAP_REPEAT", t::WRAP_REPEAT),
         ("WRAP_CLAMP", t::WRAP_CLAMP),
         ("WRAP_MIRROR", t::WRAP_MIRROR),
@@ -274,6 +285,7 @@ fn host_constants_match_their_wgsl_declarations() {
         ("MODEL_LOBES", m::MODEL_LOBES),
         ("MODEL_METAL_ROUGH", m::MODEL_METAL_ROUGH),
         ("MODEL_PARAMS", m::MODEL_PARAMS as u32),
+        ("SHEEN_TABLE", m::SHEEN_TABLE),
     ];
     for (name, host) in pairs {
         assert_eq!(wgsl_constant(&integrator, name), host, "{name}");

@@ -271,6 +271,12 @@ pub struct MaterialDesc {
     pub clearcoat: Option<f32>,
     /// Metal-rough: the coat's perceptual roughness, in [0, 1].
     pub clearcoat_roughness: Option<f32>,
+    /// Metal-rough: linear colour of a sheen over the material, in [0, 1]
+    /// (`KHR_materials_sheen`'s `sheenColorFactor`; black: none).
+    #[serde(default, deserialize_with = "exact::optional_array")]
+    pub sheen_color: Option<[f32; 3]>,
+    /// Metal-rough: the sheen's perceptual roughness, in [0, 1].
+    pub sheen_roughness: Option<f32>,
 }
 
 /// A material model, as `model = "..."` names it.

@@ -27,7 +27,9 @@ pub use error::{RangeError, SceneError};
 pub use gltf_file::{GREY_SKY, GltfModel, gltf_scene, load_gltf};
 pub use light::{Cone, Light, LightKind};
 pub use load::{SceneSource, load_scene, load_scene_file};
-pub use material::{AlphaMode, Conductor, Lobes, Material, MetalRough, Model, TextureRef, Wrap};
+pub use material::{
+    AlphaMode, Conductor, LayerTextures, Lobes, Material, MetalRough, Model, TextureRef, Wrap,
+};
 pub use settings::{RenderSettings, Sampler};
 pub use shape::{Object, Shape, TriangleMesh};
 pub use texture::Texture;

@@ -176,9 +176,9 @@ impl Material {
 
     /// Every texture the material reads, its own and its model's.
     pub fn textures_mut(&mut self) -> impl Iterator<Item = &mut TextureRef> {
-        let model = match &mut self.model {
-            Model::Lobes(_) => None,
-            Model::MetalRough(pbr) => pbr.metal_rough_texture.as_mut(),
+        let (model, layers) = match &mut self.model {
+            Model::Lobes(_) => (None, None),
+            Model::MetalRough(pbr) => (pbr.metal_rough_texture.as_mut(), Some(&mut pbr.textures)),
         };
         [
             self.texture.as_mut(),
@@ -188,6 +188,7 @@ impl Material {
         ]
         .into_iter()
         .flatten()
+        .chain(layers.into_iter().flat_map(LayerTextures::iter_mut))
     }
 }
 
@@ -291,6 +292,73 @@ pub struct MetalRough {
     /// material: light crossing it keeps `exp(-attenuation d)` over a distance d
     /// (`KHR_materials_volume`'s `-ln(attenuationColor) / attenuationDistance`); zero: clear.
     pub attenuation: Vec3,
+    /// Linear colour of a sheen over the material (`KHR_materials_sheen`'s
+    /// `sheenColorFactor`; black: none).
+    pub sheen_color: Vec3,
+    /// The sheen's perceptual roughness (`sheenRoughnessFactor`; read as at least 0.07).
+    pub sheen_roughness: f32,
+    /// The extensions' textures, each multiplying its factor.
+    pub textures: LayerTextures,
+}
+
+/// The metal-rough extensions' textures (glTF's channels; each multiplies its factor).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LayerTextures {
+    /// `KHR_materials_transmission`: transmission in red.
+    pub transmission: Option<TextureRef>,
+    /// `KHR_materials_specular`: strength in alpha.
+    pub specular: Option<TextureRef>,
+    /// `KHR_materials_specular`: F0 colour (sRGB).
+    pub specular_color: Option<TextureRef>,
+    /// `KHR_materials_clearcoat`: strength in red.
+    pub clearcoat: Option<TextureRef>,
+    /// `KHR_materials_clearcoat`: roughness in green.
+    pub clearcoat_roughness: Option<TextureRef>,
+    /// `KHR_materials_sheen`: colour (sRGB).
+    pub sheen_color: Option<TextureRef>,
+    /// `KHR_materials_sheen`: roughness in alpha.
+    pub sheen_roughness: Option<TextureRef>,
+}
+
+impl LayerTextures {
+    /// No textures.
+    pub const NONE: Self = Self {
+        transmission: None,
+        specular: None,
+        specular_color: None,
+        clearcoat: None,
+        clearcoat_roughness: None,
+        sheen_color: None,
+        sheen_roughness: None,
+    };
+
+    /// In the order of the kernels' texture slots (`TEXTURE_TRANSMISSION` onwards).
+    pub fn in_slot_order(&self) -> [Option<TextureRef>; 7] {
+        [
+            self.transmission,
+            self.specular,
+            self.specular_color,
+            self.clearcoat,
+            self.clearcoat_roughness,
+            self.sheen_color,
+            self.sheen_roughness,
+        ]
+    }
+
+    /// The same, to be changed.
+    fn iter_mut(&mut self) -> impl Iterator<Item = &mut TextureRef> {
+        [
+            self.transmission.as_mut(),
+            self.specular.as_mut(),
+            self.specular_color.as_mut(),
+            self.clearcoat.as_mut(),
+            self.clearcoat_roughness.as_mut(),
+            self.sheen_color.as_mut(),
+            self.sheen_roughness.as_mut(),
+        ]
+        .into_iter()
+        .flatten()
+    }
 }
 
 impl MetalRough {
@@ -308,5 +376,8 @@ impl MetalRough {
         clearcoat: 0.0,
         clearcoat_roughness: 0.0,
         attenuation: Vec3::ZERO,
+        sheen_color: Vec3::ZERO,
+        sheen_roughness: 0.0,
+        textures: LayerTextures::NONE,
     };
 }

@@ -117,7 +117,7 @@ pub fn load_gltf(path: &Path, transform: Mat4) -> Result<GltfModel, SceneError> 
     let mut walk = Walk {
         files: &files,
         buffers: &buffers,
-        materials: Materials::new(),
+        materials: Materials::new(&document),
         model: GltfModel {
             objects: Vec::new(),
             materials: Vec::new(),
@@ -151,11 +151,12 @@ pub fn load_gltf(path: &Path, transform: Mat4) -> Result<GltfModel, SceneError> 
 }
 
 /// The extensions pathlight reads (`KHR_draco_mesh_compression` is refused).
-const SUPPORTED_EXTENSIONS: [&str; 8] = [
+const SUPPORTED_EXTENSIONS: [&str; 9] = [
     "KHR_lights_punctual",
     "KHR_materials_clearcoat",
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
+    "KHR_materials_sheen",
     "KHR_materials_specular",
     "KHR_materials_transmission",
     "KHR_materials_volume",
@@ -182,7 +183,7 @@ fn warn_unsupported_extensions(path: &Path, document: &gltf::Document) {
 struct Walk<'a> {
     files: &'a Files<'a>,
     buffers: &'a [Vec<u8>],
-    materials: Materials,
+    materials: Materials<'a>,
     model: GltfModel,
     /// The nodes above the current one (a node among them again is a cycle).
     ancestors: Vec<usize>,

@@ -14,7 +14,7 @@ use crate::{Conductor, Lobes, Material, MetalRough, Model, TextureRef};
 
 /// Every model-specific key with the model it belongs to, and whether `m` gives it (`ior`
 /// belongs to both models and is not listed).
-fn model_keys(m: &MaterialDesc) -> [(ModelDesc, &'static str, bool); 15] {
+fn model_keys(m: &MaterialDesc) -> [(ModelDesc, &'static str, bool); 17] {
     use ModelDesc::{Lobes, MetalRough};
     [
         (Lobes, "preset", m.preset.is_some()),
@@ -40,6 +40,8 @@ fn model_keys(m: &MaterialDesc) -> [(ModelDesc, &'static str, bool); 15] {
             "clearcoat_roughness",
             m.clearcoat_roughness.is_some(),
         ),
+        (MetalRough, "sheen_color", m.sheen_color.is_some()),
+        (MetalRough, "sheen_roughness", m.sheen_roughness.is_some()),
     ]
 }
 
@@ -223,9 +225,25 @@ impl Builder<'_, '_> {
                 m.clearcoat_roughness.unwrap_or(0.0),
             )?,
             specular_color: match m.specular_color {
-                Some(c) => self.radiance(span, &key("specular_color"), c)?,
+                Some(c) => self.radiance(span.clone(), &key("specular_color"), c)?,
                 None => Vec3::ONE,
             },
+            sheen_color: match m.sheen_color {
+                Some(c) => {
+                    let key = key("sheen_color");
+                    let c = self.radiance(span.clone(), &key, c)?;
+                    if c.max_element() > 1.0 {
+                        return Err(self.invalid(span, format!("{key} = {c}: must lie in [0, 1]")));
+                    }
+                    c
+                }
+                None => Vec3::ZERO,
+            },
+            sheen_roughness: self.unit(
+                span.clone(),
+                &key("sheen_roughness"),
+                m.sheen_roughness.unwrap_or(0.0),
+            )?,
             ior,
             ..MetalRough::DEFAULT
         })
