@@ -195,6 +195,9 @@ impl Material {
 /// A material model: how a surface scatters light. The kernels hold one BSDF per model
 /// (ARCHITECTURE.md, "How to add a material model").
 #[derive(Debug, Clone, Copy, PartialEq)]
+// A scene holds a few materials, copied while it loads: their size does not matter, and
+// boxing the metal-rough one would cost every use its `Copy`.
+#[allow(clippy::large_enum_variant)]
 pub enum Model {
     /// The seed's mixture of Lambert, specular and transmission lobes.
     Lobes(Lobes),
