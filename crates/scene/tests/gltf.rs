@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use base64::Engine;
 use glam::{Mat4, Quat, Vec3};
 use pathlight_scene::{
-    AlphaMode, Environment, LightKind, Model, Scene, SceneSource, Shape, TriangleMesh, gltf_scene,
-    load_gltf, load_scene,
+    AlphaMode, Environment, LightKind, Model, Scene, SceneSource, Shape, TextureRef, TriangleMesh,
+    gltf_scene, load_gltf, load_scene,
 };
 
 fn data(path: &str) -> PathBuf {
@@ -597,4 +597,68 @@ fn specular_clearcoat_and_volume_factors_are_read() {
     assert_eq!((m.specular, m.specular_color), (1.0, Vec3::ONE));
     assert_eq!((m.clearcoat, m.clearcoat_roughness), (0.0, 0.0));
     assert_eq!(m.attenuation, Vec3::ZERO);
+}
+
+/// `KHR_materials_sheen` and the extensions' textures: factors read, textures placed in
+/// their slots with their own `texCoord` and `KHR_texture_transform` (also those the `gltf`
+/// crate does not read: the clear coat's and the sheen's), an index past the file's
+/// textures refused naming the material and key, and no warning about a supported one.
+#[test]
+fn sheen_and_the_extensions_textures_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let original =
+        std::fs::read_to_string(data("BoxTextured-glTF-Embedded/BoxTextured.gltf")).unwrap();
+    let extensions = r#""extensions": {
+        "KHR_materials_sheen": {"sheenColorFactor": [0.9, 0.5, 0.1], "sheenRoughnessFactor": 0.4,
+            "sheenColorTexture": {"index": 0}, "sheenRoughnessTexture": {"index": 0,
+            "extensions": {"KHR_texture_transform": {"offset": [0.5, 0], "scale": [2, 2]}}}},
+        "KHR_materials_clearcoat": {"clearcoatFactor": 0.6, "clearcoatTexture": {"index": 0},
+            "clearcoatRoughnessTexture": {"index": 0}},
+        "KHR_materials_transmission": {"transmissionFactor": 0.5,
+            "transmissionTexture": {"index": 0}},
+        "KHR_materials_specular": {"specularTexture": {"index": 0},
+            "specularColorTexture": {"index": 0}}},
+        "pbrMetallicRoughness": {"#;
+    let write = |text: String| {
+        let path = dir.path().join("layers.gltf");
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let path = write(original.replacen(r#""pbrMetallicRoughness": {"#, extensions, 1));
+    let scene = gltf_scene(&path, None).unwrap();
+    let Model::MetalRough(m) = &scene.materials[0].model else {
+        panic!("{:?}", scene.materials[0])
+    };
+    assert_eq!(m.sheen_color, Vec3::new(0.9, 0.5, 0.1));
+    assert_eq!((m.sheen_roughness, m.clearcoat), (0.4, 0.6));
+    let t = m.textures;
+    for (name, slot) in [
+        ("transmission", t.transmission),
+        ("specular", t.specular),
+        ("specular colour", t.specular_color),
+        ("clear coat", t.clearcoat),
+        ("clear coat roughness", t.clearcoat_roughness),
+        ("sheen colour", t.sheen_color),
+    ] {
+        let slot = slot.unwrap_or_else(|| panic!("no {name} texture"));
+        assert_eq!(slot.texture, 0, "{name}");
+        assert_eq!(slot.transform, TextureRef::IDENTITY, "{name}");
+    }
+    let shifted = t.sheen_roughness.expect("no sheen roughness texture");
+    assert_eq!(shifted.transform, [[2.0, 0.0, 0.5], [0.0, 2.0, 0.0]]);
+    // One image, decoded once for all its uses.
+    assert_eq!(scene.textures.len(), 1);
+    let bad = write(original.replacen(
+        r#""pbrMetallicRoughness": {"#,
+        &extensions.replace(
+            r#""clearcoatTexture": {"index": 0}"#,
+            r#""clearcoatTexture": {"index": 7}"#,
+        ),
+        1,
+    ));
+    let message = gltf_scene(&bad, None).unwrap_err().to_string();
+    assert!(
+        message.contains("material 0: KHR_materials_clearcoat.clearcoatTexture: names no texture"),
+        "{message}"
+    );
 }

@@ -59,7 +59,7 @@ fn gpu_and_cpu_render_the_same_image() {
 /// The lights reference scene with every light made soft: the point light a sphere, the
 /// spot's edge smooth (and its light from a sphere too), the sun a disk of 5 degrees; and
 /// its white sphere a glTF dielectric with a coloured `KHR_materials_specular`, its blue one
-/// under a clear coat, its gold one solid glass that absorbs (`KHR_materials_volume`).
+/// a sheen under a clear coat, its gold one solid glass that absorbs (`KHR_materials_volume`).
 fn soft_lights() -> Scene {
     let mut s = scene("refs/lights.toml", 40, 4, 2);
     let white = s.materials.iter_mut().find(|m| m.name == "white").unwrap();
@@ -82,6 +82,8 @@ fn soft_lights() -> Scene {
         roughness: 0.8,
         clearcoat: 1.0,
         clearcoat_roughness: 0.2,
+        sheen_color: Vec3::new(1.0, 0.6, 0.3),
+        sheen_roughness: 0.3,
         ..MetalRough::DEFAULT
     });
     for light in &mut s.lights {
