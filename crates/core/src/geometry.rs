@@ -9,9 +9,10 @@
 use std::time::{Duration, Instant};
 
 use bytemuck::Zeroable;
-use glam::{Vec3, Vec3A};
+use glam::{Vec3, Vec3A, Vec4};
 use obvhs::aabb::Aabb;
 use pathlight_scene::settings::MAX_COORDINATE;
+use pathlight_scene::texture::linear_to_srgb;
 use pathlight_scene::{Object, Shape, TriangleMesh};
 use rayon::prelude::*;
 
@@ -19,7 +20,7 @@ use crate::bvh;
 use crate::error::GeometryError;
 use crate::gpu_types::{
     FLAG_CAPS, FLAG_FLAT, GpuObject, GpuPrimitive, GpuVertex, GpuWideNode, KIND_CYLINDER,
-    KIND_MESH, KIND_QUAD, KIND_SPHERE, NO_LIGHT, NO_TRIANGLE,
+    KIND_MESH, KIND_QUAD, KIND_SPHERE, NO_LIGHT, NO_TRIANGLE, WHITE,
 };
 use crate::octahedral;
 
@@ -214,9 +215,10 @@ impl Geometry {
                             mesh.normals.get(v).copied().unwrap_or_default(),
                         ),
                         uv: mesh.uvs.get(v).copied().unwrap_or_default().to_array(),
-                        tangent: tangent
-                            .map_or(octahedral::ZERO, |t| octahedral::encode(t.truncate())),
-                        tangent_sign: tangent.map_or(1.0, |t| if t.w < 0.0 { -1.0 } else { 1.0 }),
+                        tangent: tangent.map_or(octahedral::ZERO, |t| {
+                            octahedral::encode_tangent(t.truncate(), t.w)
+                        }),
+                        color: mesh.colors.get(v).map_or(WHITE, |&c| pack_color(c)),
                     }
                 })
             })
@@ -663,4 +665,12 @@ mod tests {
         };
         assert!(bytes(&one) == bytes(&four), "the buffers differ");
     }
+}
+
+/// Linear RGBA `c` (clamped to [0, 1]) as [`GpuVertex::color`]: the colour channels
+/// sRGB-encoded, so that 8 bits keep dark colours apart.
+fn pack_color(c: Vec4) -> u32 {
+    let byte = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
+    let srgb = |x: f32| byte(linear_to_srgb(x.clamp(0.0, 1.0)));
+    u32::from_le_bytes([srgb(c.x), srgb(c.y), srgb(c.z), byte(c.w)])
 }

@@ -136,11 +136,17 @@ pub struct GpuVertex {
     pub normal: u32,
     /// Texture coordinates.
     pub uv: [f32; 2],
-    /// Tangent along +u (unit; [`crate::octahedral::ZERO`] when the mesh has none).
+    /// Tangent along +u (unit; [`crate::octahedral::ZERO`] when the mesh has none), with the
+    /// sign of the bitangent in [`crate::octahedral::SIGN_BIT`]: `cross(normal, tangent) *
+    /// sign` points along +v.
     pub tangent: u32,
-    /// Sign of the bitangent: `cross(normal, tangent) * tangent_sign` points along +v.
-    pub tangent_sign: f32,
+    /// Vertex colour as RGBA8: red in the low byte, the colour channels sRGB-encoded
+    /// (linear once decoded), alpha linear; [`WHITE`] without one.
+    pub color: u32,
 }
+
+/// [`GpuVertex::color`] of a vertex without a colour: opaque white.
+pub const WHITE: u32 = u32::MAX;
 const _: () = assert!(size_of::<GpuVertex>() == 32);
 
 /// [`GpuPrimitive::triangle`] of a quad, sphere or cylinder.

@@ -169,7 +169,7 @@ impl Path {
             return None;
         };
         let s = surface_at(scene, &hit, &ray);
-        let material = &material_at(scene, s.material, s.uv);
+        let material = &material_at(scene, &s);
         let wo = -Vec3A::from(ray.dir);
         if wo.dot(s.ng) < 0.0 {
             // The segment ran inside the object it leaves: Beer-Lambert.

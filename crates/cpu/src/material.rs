@@ -35,9 +35,11 @@ pub struct MaterialPoint {
     pub params: [Vec4; MODEL_PARAMS],
 }
 
-/// Material `index` at texture coordinates `uv`. Twin of WGSL `material_at`.
+/// The material of surface `s` at its texture coordinates, its base colour times the vertex
+/// colour. Twin of WGSL `material_at`.
 #[inline(always)]
-pub fn material_at(scene: &CpuScene, index: u32, uv: Vec2) -> MaterialPoint {
+pub fn material_at(scene: &CpuScene, s: &Surface) -> MaterialPoint {
+    let (index, uv) = (s.material, s.uv);
     let m = &scene.materials[index as usize];
     let first = m.params as usize;
     let block = &scene.param_blocks[first..first + MODEL_PARAMS];
@@ -51,12 +53,12 @@ pub fn material_at(scene: &CpuScene, index: u32, uv: Vec2) -> MaterialPoint {
     if m.flags & MATERIAL_LONG_BLOCK != 0 {
         params[4] = Vec4::from_array(block[4]);
     }
-    let mut base_color = Vec3A::from(m.base_color);
+    let mut base_color = Vec3A::from(m.base_color) * s.color;
     if has_texture(m, TEXTURE_BASE) {
         let texel = material_texture(scene, m, TEXTURE_BASE, uv)
             .truncate()
             .into();
-        base_color = Vec3A::from(m.base_color) * srgb_to_linear(texel);
+        base_color *= srgb_to_linear(texel);
     }
     if m.model == MODEL_METAL_ROUGH {
         metal_rough_textured(scene, &mut params, m, uv);

@@ -7,13 +7,13 @@ use glam::{Vec2, Vec3A};
 use pathlight_core::gpu_types::{
     FLAG_CAPS, FLAG_FLAT, GpuMaterial, KIND_CYLINDER, KIND_QUAD, KIND_SPHERE, TEXTURE_NORMAL,
 };
-use pathlight_core::octahedral;
+use pathlight_core::octahedral::{self, tangent_sign};
 
 use crate::bvh::Hit;
 use crate::cpu_scene::CpuScene;
 use crate::intersect::Ray;
 use crate::sampling::Frame;
-use crate::textures::{has_texture, material_texture};
+use crate::textures::{has_texture, material_texture, triangle_color};
 
 /// The surface at a hit. Twin of WGSL `Surface`.
 #[derive(Debug, Clone, Copy)]
@@ -28,6 +28,8 @@ pub struct Surface {
     pub uv: Vec2,
     /// Material index.
     pub material: u32,
+    /// The vertex colour (white but on meshes with `COLOR_0`), multiplying the base colour.
+    pub color: Vec3A,
 }
 
 /// The shading normal bent by the material's normal map. Twin of WGSL `normal_mapped`.
@@ -92,6 +94,7 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
         ns: Vec3A::Y,
         uv: Vec2::ZERO,
         material: o.material,
+        color: Vec3A::ONE,
     };
     match o.kind {
         KIND_QUAD => {
@@ -144,6 +147,9 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
             let n =
                 b0 * decode(v0.normal) + hit.b1 * decode(v1.normal) + hit.b2 * decode(v2.normal);
             s.uv = b0 * Vec2::from(v0.uv) + hit.b1 * Vec2::from(v1.uv) + hit.b2 * Vec2::from(v2.uv);
+            s.color = triangle_color(scene, hit.primitive, hit.b1, hit.b2)
+                .truncate()
+                .into();
             if o.flags & FLAG_FLAT != 0 || n.dot(n) < 1e-12 {
                 s.ns = s.ng;
             } else {
@@ -154,7 +160,7 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
                 let tangent = b0 * decode(v0.tangent)
                     + hit.b1 * decode(v1.tangent)
                     + hit.b2 * decode(v2.tangent);
-                s.ns = normal_mapped(scene, m, s.uv, s.ns, tangent, v0.tangent_sign);
+                s.ns = normal_mapped(scene, m, s.uv, s.ns, tangent, tangent_sign(v0.tangent));
                 let wo = -Vec3A::from(ray.dir);
                 let side = if wo.dot(s.ng) >= 0.0 { 1.0 } else { -1.0 };
                 s.ns = side * valid_reflection_normal(side * s.ng, wo, side * s.ns);

@@ -3,7 +3,8 @@
 
 use glam::{Vec2, Vec3A, Vec4};
 use pathlight_core::gpu_types::{
-    GpuMaterial, GpuTextureSlot, MATERIAL_MASK, TEXTURE_BASE, WRAP_CLAMP, WRAP_MIRROR, WRAP_REPEAT,
+    GpuMaterial, GpuTextureSlot, MATERIAL_MASK, TEXTURE_BASE, WHITE, WRAP_CLAMP, WRAP_MIRROR,
+    WRAP_REPEAT,
 };
 
 use crate::cpu_scene::CpuScene;
@@ -102,12 +103,31 @@ fn blend_threshold(triangle: u32, t: f32) -> f32 {
     (h >> 8) as f32 * (1.0 / 16_777_216.0)
 }
 
+/// A vertex colour's code decoded: linear RGBA. Twin of WGSL `vertex_color`.
+#[inline(always)]
+fn vertex_color(code: u32) -> Vec4 {
+    let c = Vec4::from_array(code.to_le_bytes().map(f32::from)) / 255.0;
+    srgb_to_linear(c.truncate().into()).extend(c.w)
+}
+
+/// The vertex colour at barycentrics (b1, b2) of `triangle`: opaque white when its corners
+/// have none. Twin of WGSL `triangle_color`.
+#[inline(always)]
+pub fn triangle_color(scene: &CpuScene, triangle: u32, b1: f32, b2: f32) -> Vec4 {
+    let i = 3 * triangle as usize;
+    let [c0, c1, c2] = [0, 1, 2].map(|k| scene.vertices[i + k].color);
+    if c0 & c1 & c2 == WHITE {
+        return Vec4::ONE;
+    }
+    (1.0 - b1 - b2) * vertex_color(c0) + b1 * vertex_color(c1) + b2 * vertex_color(c2)
+}
+
 /// Whether a ray stops at (b1, b2), distance `t`, on `triangle` of `object`, whose
 /// material has alpha holes. Twin of WGSL `alpha_stops`.
 #[inline(never)]
 pub fn alpha_stops(scene: &CpuScene, object: u32, triangle: u32, b1: f32, b2: f32, t: f32) -> bool {
     let m = &scene.materials[scene.objects[object as usize].material as usize];
-    let mut alpha = m.alpha_factor;
+    let mut alpha = m.alpha_factor * triangle_color(scene, triangle, b1, b2).w;
     if has_texture(m, TEXTURE_BASE) {
         let uv = triangle_uv(scene, triangle, b1, b2);
         alpha *= material_texture(scene, m, TEXTURE_BASE, uv).w;

@@ -234,6 +234,7 @@ fn surface() -> Surface {
         ns: Vec3A::Z,
         uv: Vec2::ZERO,
         material: 0,
+        color: Vec3A::ONE,
     }
 }
 

@@ -173,7 +173,7 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> PathResult {
             break;
         }
         let s = surface_at(hit, ray);
-        let material = material_at(s.material, s.uv);
+        let material = material_at(s);
         let wo = -ray.dir;
         if dot(wo, s.ng) < 0.0 {
             // The segment ran inside the object it leaves: Beer-Lambert.

@@ -27,9 +27,12 @@ struct MaterialPoint {
     params: array<vec4f, MODEL_PARAMS>,
 }
 
-// Material `index` at texture coordinates `uv`.
+// The material of surface `s` at its texture coordinates, its base colour times the
+// vertex colour.
 // CPU twin: `material_at`.
-fn material_at(index: u32, uv: vec2f) -> MaterialPoint {
+fn material_at(s: Surface) -> MaterialPoint {
+    let index = s.material;
+    let uv = s.uv;
     let m = materials[index];
     // Loaded with constant indices (MODEL_PARAMS of them): an array indexed at run time
     // would be kept in memory rather than in registers.
@@ -38,9 +41,9 @@ fn material_at(index: u32, uv: vec2f) -> MaterialPoint {
     if (m.flags & MATERIAL_LONG_BLOCK) != 0u {
         params[4] = param_blocks[m.params + 4u];
     }
-    var base_color = m.base_color;
+    var base_color = m.base_color * s.color;
     if has_texture(m, TEXTURE_BASE) {
-        base_color = m.base_color * srgb_to_linear(material_texture(m, TEXTURE_BASE, uv).rgb);
+        base_color *= srgb_to_linear(material_texture(m, TEXTURE_BASE, uv).rgb);
     }
     switch m.model {
         case MODEL_METAL_ROUGH: {

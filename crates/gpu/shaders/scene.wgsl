@@ -59,14 +59,19 @@ struct WideNode {
 }
 
 // A triangle corner; triangle i is vertices 3i, 3i+1, 3i+2. Host: `GpuVertex`.
-// Normal and tangent are octahedral codes (`decode_unit` in surface.wgsl).
+// Normal and tangent are octahedral codes (`decode_unit` in surface.wgsl), the tangent's
+// with the bitangent's sign in bit 16 (`tangent_sign`); the colour RGBA8 with sRGB-encoded
+// colour channels (`vertex_color` in textures.wgsl), 0xffffffff for none.
 struct Vertex {
     position: vec3f,
     normal: u32,
     uv: vec2f,
     tangent: u32,
-    tangent_sign: f32,
+    color: u32,
 }
+
+// A vertex colour's code for opaque white (host: `WHITE`).
+const WHITE: u32 = 0xffffffffu;
 
 // A primitive of the BVH, in leaf order: a triangle with its corners (`triangle` is its
 // index in `vertices`) or, with `triangle` NO_TRIANGLE, the whole shape `object`. Host:

@@ -17,6 +17,14 @@ struct Surface {
     ns: vec3f,
     uv: vec2f,
     material: u32,
+    // The vertex colour (white but on meshes with COLOR_0), multiplying the base colour.
+    color: vec3f,
+}
+
+// The sign of the bitangent in a tangent's code: -1 or 1.
+// Host twin: `pathlight_core::octahedral::tangent_sign`.
+fn tangent_sign(code: u32) -> f32 {
+    return select(1.0, -1.0, (code & 0x10000u) != 0u);
 }
 
 // The unit vector of an octahedral code; zero for the code 0x80008000.
@@ -74,7 +82,7 @@ fn valid_reflection_normal(ng: vec3f, wo: vec3f, n: vec3f) -> vec3f {
 fn surface_at(hit: Hit, ray: Ray) -> Surface {
     let o = objects[hit.object];
     let p = ray.origin + hit.t * ray.dir;
-    var s = Surface(p, vec3f(0.0, 1.0, 0.0), vec3f(0.0, 1.0, 0.0), vec2f(0.0), o.material);
+    var s = Surface(p, vec3f(0.0, 1.0, 0.0), vec3f(0.0, 1.0, 0.0), vec2f(0.0), o.material, vec3f(1.0));
     switch o.kind {
         case KIND_QUAD: {
             s.ng = normalize(cross(o.b.xyz, o.c.xyz));
@@ -116,6 +124,7 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
             s.ng = normalize(cross(v1.position - v0.position, v2.position - v0.position));
             let n = b0 * decode_unit(v0.normal) + hit.b1 * decode_unit(v1.normal) + hit.b2 * decode_unit(v2.normal);
             s.uv = b0 * v0.uv + hit.b1 * v1.uv + hit.b2 * v2.uv;
+            s.color = triangle_color(hit.primitive, hit.b1, hit.b2).rgb;
             if (o.flags & FLAG_FLAT) != 0u || dot(n, n) < 1e-12 {
                 s.ns = s.ng;
             } else {
@@ -124,7 +133,7 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
             let m = materials[o.material];
             if has_texture(m, TEXTURE_NORMAL) {
                 let tangent = b0 * decode_unit(v0.tangent) + hit.b1 * decode_unit(v1.tangent) + hit.b2 * decode_unit(v2.tangent);
-                s.ns = normal_mapped(m, s.uv, s.ns, tangent, v0.tangent_sign);
+                s.ns = normal_mapped(m, s.uv, s.ns, tangent, tangent_sign(v0.tangent));
                 let wo = -ray.dir;
                 let side = select(-1.0, 1.0, dot(wo, s.ng) >= 0.0);
                 s.ns = side * valid_reflection_normal(side * s.ng, wo, side * s.ns);

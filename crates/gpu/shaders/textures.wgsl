@@ -86,12 +86,33 @@ fn blend_threshold(triangle: u32, t: f32) -> f32 {
     return f32(h >> 8u) * (1.0 / 16777216.0);
 }
 
+// A vertex colour's code decoded: linear RGBA.
+// CPU twin: `vertex_color`.
+fn vertex_color(code: u32) -> vec4f {
+    let c = unpack4x8unorm(code);
+    return vec4f(srgb_to_linear(c.rgb), c.a);
+}
+
+// The vertex colour at barycentrics (b1, b2) of `triangle`: opaque white when its corners
+// have none.
+// CPU twin: `triangle_color`.
+fn triangle_color(triangle: u32, b1: f32, b2: f32) -> vec4f {
+    let i = 3u * triangle;
+    let c0 = vertices[i].color;
+    let c1 = vertices[i + 1u].color;
+    let c2 = vertices[i + 2u].color;
+    if (c0 & c1 & c2) == WHITE {
+        return vec4f(1.0);
+    }
+    return (1.0 - b1 - b2) * vertex_color(c0) + b1 * vertex_color(c1) + b2 * vertex_color(c2);
+}
+
 // Whether a ray stops at (b1, b2), distance t, on triangle `triangle` of `object` (whose
 // material has alpha holes): its alpha reaches the cutoff (MASK) or the blend threshold.
 // CPU twin: `alpha_stops`.
 fn alpha_stops(object: u32, triangle: u32, b1: f32, b2: f32, t: f32) -> bool {
     let m = materials[objects[object].material];
-    var alpha = m.alpha_factor;
+    var alpha = m.alpha_factor * triangle_color(triangle, b1, b2).a;
     if has_texture(m, TEXTURE_BASE) {
         alpha *= material_texture(m, TEXTURE_BASE, triangle_uv(triangle, b1, b2)).a;
     }

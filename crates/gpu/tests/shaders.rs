@@ -131,7 +131,7 @@ fn host_structs_match_their_wgsl_declarations() {
         m,
         "Vertex",
         GpuVertex,
-        [position, normal, uv, tangent, tangent_sign]
+        [position, normal, uv, tangent, color]
     );
     assert_layout!(
         m,
@@ -263,6 +263,7 @@ fn host_constants_match_their_wgsl_declarations() {
         ("MATERIAL_MASK", t::MATERIAL_MASK),
         ("MATERIAL_BLEND", t::MATERIAL_BLEND),
         ("MATERIAL_LONG_BLOCK", t::MATERIAL_LONG_BLOCK),
+        ("WHITE", t::WHITE),
         ("TEXTURE_BASE", t::TEXTURE_BASE),
         ("TEXTURE_NORMAL", t::TEXTURE_NORMAL),
         ("TEXTURE_EMISSION", t::TEXTURE_EMISSION),

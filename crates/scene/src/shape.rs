@@ -18,6 +18,9 @@ pub struct TriangleMesh {
     /// -v, up in the image, glTF's convention); empty when no material of the mesh needs
     /// them (normal maps do).
     pub tangents: Vec<Vec4>,
+    /// Vertex colours (linear RGBA, one per position; glTF's `COLOR_0`), multiplying the
+    /// base colour and its alpha; empty for none.
+    pub colors: Vec<Vec4>,
     /// Shade with the geometric normal instead of `normals`.
     pub flat: bool,
 }

@@ -260,6 +260,7 @@ pub fn icosphere(subdivisions: u32) -> TriangleMesh {
         positions,
         indices: faces,
         tangents: Vec::new(),
+        colors: Vec::new(),
         flat: false,
     }
 }

@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 use base64::Engine;
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat4, Quat, Vec3, Vec4};
 use pathlight_scene::{
     AlphaMode, Environment, LightKind, Model, Scene, SceneSource, Shape, TextureRef, TriangleMesh,
     gltf_scene, load_gltf, load_scene,
@@ -659,6 +659,81 @@ fn sheen_and_the_extensions_textures_are_read() {
     let message = gltf_scene(&bad, None).unwrap_err().to_string();
     assert!(
         message.contains("material 0: KHR_materials_clearcoat.clearcoatTexture: names no texture"),
+        "{message}"
+    );
+}
+
+/// `COLOR_0` as normalised bytes (VEC4) or floats (VEC3, alpha 1) becomes the mesh's linear
+/// vertex colours; a colour accessor of another shape is refused naming the primitive.
+#[test]
+fn vertex_colours_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let positions: Vec<u8> = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+        .iter()
+        .flatten()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    let write = |colors: Vec<u8>, accessor: &str| {
+        let bytes: Vec<u8> = positions
+            .iter()
+            .copied()
+            .chain(colors.iter().copied())
+            .collect();
+        let uri = format!(
+            "data:application/octet-stream;base64,{}",
+            base64::engine::general_purpose::STANDARD.encode(&bytes)
+        );
+        let json = format!(
+            r#"{{"asset": {{"version": "2.0"}}, "scene": 0, "scenes": [{{"nodes": [0]}}],
+            "nodes": [{{"mesh": 0}}],
+            "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "COLOR_0": 1}}}}]}}],
+            "buffers": [{{"byteLength": {}, "uri": "{uri}"}}],
+            "bufferViews": [{{"buffer": 0, "byteLength": 36}},
+                {{"buffer": 0, "byteOffset": 36, "byteLength": {}}}],
+            "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                "min": [0, 0, 0], "max": [1, 1, 0]}}, {accessor}]}}"#,
+            bytes.len(),
+            colors.len()
+        );
+        let path = dir.path().join("colours.gltf");
+        std::fs::write(&path, json).unwrap();
+        gltf_scene(&path, None)
+    };
+    let mesh = |scene: &Scene| match &scene.objects[0].shape {
+        Shape::Mesh(m) => m.clone(),
+        other => panic!("{other:?}"),
+    };
+    let bytes = write(
+        vec![255, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0],
+        r#"{"bufferView": 1, "componentType": 5121, "normalized": true, "count": 3, "type": "VEC4"}"#,
+    )
+    .unwrap();
+    assert_eq!(
+        mesh(&bytes).colors,
+        vec![
+            Vec4::new(1.0, 0.0, 0.0, 1.0),
+            Vec4::new(0.0, 1.0, 0.0, 128.0 / 255.0),
+            Vec4::new(0.0, 0.0, 1.0, 0.0)
+        ]
+    );
+    let floats: Vec<u8> = [0.5f32, 0.25, 0.125, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    let floats = write(
+        floats,
+        r#"{"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC3"}"#,
+    )
+    .unwrap();
+    assert_eq!(mesh(&floats).colors[0], Vec4::new(0.5, 0.25, 0.125, 1.0));
+    let message = write(
+        vec![0; 6],
+        r#"{"bufferView": 1, "componentType": 5121, "normalized": true, "count": 3, "type": "VEC2"}"#,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        message.contains("mesh 0 primitive 0: COLOR_0 is neither VEC3 nor VEC4"),
         "{message}"
     );
 }

@@ -125,6 +125,7 @@ fn quad(origin: Vec3, edge_u: Vec3, edge_v: Vec3, normal: Vec3) -> TriangleMesh 
         uvs: corners.to_vec(),
         indices: vec![[0, 1, 2], [0, 2, 3]],
         tangents: vec![edge_u.normalize().extend(-1.0); 6],
+        colors: Vec::new(),
         flat: false,
     }
 }
@@ -194,7 +195,8 @@ fn agreement(a: &Film, b: &Film) -> (f64, [f64; 3], [f64; 3]) {
 
 /// A quad whose texture's left half has alpha 0 (MASK, cutoff 0.5) shades and shadows as
 /// the right half alone does: the same image but for pixels on the cut (CPU and GPU), and
-/// one clearly unlike the whole quad's (so the test can fail).
+/// one clearly unlike the whole quad's (so the test can fail). So does a quad whose vertex
+/// colours' alpha (`COLOR_0`) runs from 0 on its left edge to 1 on its right.
 #[test]
 fn an_alpha_masked_quad_casts_the_shadow_of_its_opaque_part() {
     let edge_u = Vec3::new(2.0, 0.0, 0.0);
@@ -225,10 +227,17 @@ fn an_alpha_masked_quad_casts_the_shadow_of_its_opaque_part() {
         cut_material,
         Vec::new(),
     );
+    let mut faded = quad(origin, edge_u, edge_v, Vec3::Y);
+    faded.colors = [0.0, 1.0, 1.0, 0.0].map(|a| Vec3::ONE.extend(a)).to_vec();
+    let mut by_vertices = metal_rough("by vertices", Vec3::splat(0.5), MetalRough::DEFAULT);
+    by_vertices.alpha = AlphaMode::Mask(0.5);
+    let faded_scene = shadow_scene(Shape::Mesh(faded), by_vertices, Vec::new());
     let cut = render_cpu(&cut_scene);
     for (backend, film) in [
         ("CPU", render_cpu(&masked_scene)),
         ("GPU", render(&masked_scene)),
+        ("CPU, vertex alpha", render_cpu(&faded_scene)),
+        ("GPU, vertex alpha", render(&faded_scene)),
     ] {
         let (share, a, b) = agreement(&film, &cut);
         println!("masked ({backend}) vs cut: {share:.4} of pixels agree; means {a:?} vs {b:?}");
@@ -442,4 +451,45 @@ fn the_extensions_textures_multiply_their_factors_on_both_backends() {
         share < 0.9,
         "the textures do not show ({share} of pixels agree)"
     );
+}
+
+/// Vertex colours (`COLOR_0`) multiply the base colour: a white quad whose corners carry a
+/// colour shades as a quad of that base colour (99% of pixels within 2%, CPU and GPU), and a
+/// quad whose colour runs from black to white across it is dark on one side and bright on
+/// the other.
+#[test]
+fn vertex_colours_multiply_the_base_colour_on_both_backends() {
+    let edge_u = Vec3::new(2.0, 0.0, 0.0);
+    let edge_v = Vec3::new(0.0, 0.0, -2.0);
+    let origin = Vec3::new(-1.0, 0.5, 1.0);
+    // A colour 8 bits keep exactly (sRGB bytes 200, 120, 60).
+    let color = Vec3::from(srgb_to_linear(Vec3A::new(200.0, 120.0, 60.0) / 255.0));
+    let mut coloured = quad(origin, edge_u, edge_v, Vec3::Y);
+    coloured.colors = vec![color.extend(1.0); 4];
+    let white = metal_rough("white", Vec3::ONE, MetalRough::DEFAULT);
+    let tinted = metal_rough("tinted", color, MetalRough::DEFAULT);
+    let by_vertices = shadow_scene(Shape::Mesh(coloured), white.clone(), Vec::new());
+    let by_material = shadow_scene(
+        Shape::Mesh(quad(origin, edge_u, edge_v, Vec3::Y)),
+        tinted,
+        Vec::new(),
+    );
+    for (backend, film, reference) in [
+        ("CPU", render_cpu(&by_vertices), render_cpu(&by_material)),
+        ("GPU", render(&by_vertices), render(&by_material)),
+    ] {
+        let (share, a, b) = agreement(&film, &reference);
+        println!("vertex colours ({backend}) vs base colour: {share:.4} agree; {a:?} vs {b:?}");
+        assert!(share >= 0.99, "{backend}: only {share} of pixels agree");
+    }
+    let mut ramp = quad(origin, edge_u, edge_v, Vec3::Y);
+    ramp.colors = [0.0, 1.0, 1.0, 0.0]
+        .map(|c| Vec3::splat(c).extend(1.0))
+        .to_vec();
+    let ramp = shadow_scene(Shape::Mesh(ramp), white, Vec::new());
+    for (backend, film) in [("CPU", render_cpu(&ramp)), ("GPU", render(&ramp))] {
+        // Seen from above, +x is to the right: the quad's u runs left to right.
+        let (left, right) = (film.pixel(16, 24)[1], film.pixel(31, 24)[1]);
+        assert!(left < 0.5 * right, "{backend}: left {left}, right {right}");
+    }
 }

@@ -160,6 +160,28 @@ pub(super) fn read_primitive(
         positions,
         indices: kept,
         tangents: Vec::new(),
+        colors: match primitive.get(&gltf::Semantic::Colors(0)) {
+            Some(accessor) => {
+                let types = [DataType::F32, DataType::U8, DataType::U16];
+                if !matches!(accessor.dimensions(), Dimensions::Vec3 | Dimensions::Vec4) {
+                    return Err(files.error(&element, "COLOR_0 is neither VEC3 nor VEC4"));
+                }
+                check("COLOR_0", &accessor, accessor.dimensions(), &types)?;
+                let colors: Vec<Vec4> = reader
+                    .read_colors(0)
+                    .ok_or_else(|| files.error(&element, "cannot read COLOR_0"))?
+                    .into_rgba_f32()
+                    .map(Vec4::from)
+                    .collect();
+                if colors.len() != count || colors.iter().any(|c| !c.is_finite()) {
+                    return Err(
+                        files.error(&element, "COLOR_0 does not give a finite colour per vertex")
+                    );
+                }
+                colors
+            }
+            None => Vec::new(),
+        },
         flat,
     };
     if needs.tangents {
@@ -245,6 +267,7 @@ mod tests {
             indices: vec![[0, 1, 2]],
             // Bitangent cross(z, x) * w = -y, towards -v: up in the image.
             tangents: vec![Vec4::new(1.0, 0.0, 0.0, -1.0); 3],
+            colors: Vec::new(),
             flat: false,
         };
         // Mirror x and move: the triangle's front (+z) must still be counter-clockwise.
