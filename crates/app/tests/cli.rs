@@ -761,7 +761,7 @@ fn a_gltf_file_opens_lit_unless_told_otherwise() {
     .unwrap()
     .replace(
         r#""extensionsUsed": ["#,
-        r#""extensionsUsed": ["KHR_materials_sheen", "EXT_made_up", "#,
+        r#""extensionsUsed": ["KHR_materials_iridescence", "EXT_made_up", "#,
     );
     let unsupported = dir.path().join("unsupported.gltf");
     std::fs::write(&unsupported, &text).unwrap();
@@ -773,7 +773,7 @@ fn a_gltf_file_opens_lit_unless_told_otherwise() {
     assert!(
         err.contains(
             "uses glTF extensions pathlight does not support, which are ignored: \
-             KHR_materials_sheen, EXT_made_up"
+             KHR_materials_iridescence, EXT_made_up"
         ),
         "{err}"
     );
@@ -790,4 +790,29 @@ fn a_gltf_file_opens_lit_unless_told_otherwise() {
     // The ground under a sun of 2 W/m^2 at 60 degrees: about 0.78 x 2 x 0.5 / pi.
     let mean = lit.mean()[0];
     assert!((0.15..0.5).contains(&mean), "mean {mean}");
+}
+
+/// A glTF file that uses every material extension pathlight reads, with their textures and
+/// vertex colours (`MaterialLayers/layers.gltf`), renders without a warning, and its two
+/// materials come out unlike each other and the grey sky.
+#[test]
+fn a_gltf_file_with_every_supported_material_extension_renders_without_warnings() {
+    let dir = tempfile::tempdir().unwrap();
+    let (err, film) = render_small(
+        "crates/scene/tests/data/gltf/MaterialLayers/layers.gltf",
+        &[],
+        &dir.path().join("layers.exr"),
+    );
+    assert!(
+        !err.contains("WARN") && !err.contains("ignored"),
+        "warned:\n{err}"
+    );
+    // The camera's 2:1 view fitted into 16x16: the velvet left, the paint right, sky corners.
+    let [velvet, paint, sky] = [film.pixel(4, 8), film.pixel(11, 8), film.pixel(0, 0)];
+    assert!(
+        velvet[0] > velvet[2],
+        "the velvet is not red-pink: {velvet:?}"
+    );
+    assert!(paint[2] > paint[0], "the paint is not blue: {paint:?}");
+    assert!((sky[1] - 0.8).abs() < 0.05, "the sky: {sky:?}");
 }

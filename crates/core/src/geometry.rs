@@ -422,6 +422,14 @@ fn triangle_bounds(mesh: &TriangleMesh, t: usize) -> Aabb {
     }
 }
 
+/// Linear RGBA `c` (clamped to [0, 1]) as [`GpuVertex::color`]: the colour channels
+/// sRGB-encoded, so that 8 bits keep dark colours apart.
+fn pack_color(c: Vec4) -> u32 {
+    let byte = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
+    let srgb = |x: f32| byte(linear_to_srgb(x.clamp(0.0, 1.0)));
+    u32::from_le_bytes([srgb(c.x), srgb(c.y), srgb(c.z), byte(c.w)])
+}
+
 #[cfg(test)]
 mod tests {
     use glam::Vec3;
@@ -665,12 +673,4 @@ mod tests {
         };
         assert!(bytes(&one) == bytes(&four), "the buffers differ");
     }
-}
-
-/// Linear RGBA `c` (clamped to [0, 1]) as [`GpuVertex::color`]: the colour channels
-/// sRGB-encoded, so that 8 bits keep dark colours apart.
-fn pack_color(c: Vec4) -> u32 {
-    let byte = |x: f32| (x.clamp(0.0, 1.0) * 255.0).round() as u8;
-    let srgb = |x: f32| byte(linear_to_srgb(x.clamp(0.0, 1.0)));
-    u32::from_le_bytes([srgb(c.x), srgb(c.y), srgb(c.z), byte(c.w)])
 }

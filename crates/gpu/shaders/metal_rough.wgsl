@@ -168,8 +168,7 @@ fn eval_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, wi
     return out;
 }
 
-// The largest of v's components.
-// CPU twin: `Vec3A::max_element`.
+// The largest of v's components (glam's `max_element` on the CPU).
 fn max3(v: vec3f) -> f32 {
     return max(max(v.x, v.y), v.z);
 }

@@ -40,7 +40,7 @@ const URIS: [&str; 7] = [
 ];
 
 /// One sample: its folder (under `crates/scene/tests/data/gltf`) and its main file.
-const SAMPLES: [(&str, &str); 7] = [
+const SAMPLES: [(&str, &str); 8] = [
     ("BoxTextured-glTF-Binary", "BoxTextured.glb"),
     ("BoxTextured-glTF-Embedded", "BoxTextured.gltf"),
     ("cameras", "Cameras.gltf"),
@@ -48,6 +48,7 @@ const SAMPLES: [(&str, &str); 7] = [
     ("Mesh_PrimitiveMode", "Mesh_PrimitiveMode_11.gltf"),
     ("Mesh_PrimitiveMode", "Mesh_PrimitiveMode_05.gltf"),
     ("PunctualLights", "lights.gltf"),
+    ("MaterialLayers", "layers.gltf"),
 ];
 
 /// A glTF case: the sample it mutates, its main file's name, and every file of its folder
