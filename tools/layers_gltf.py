@@ -3,7 +3,7 @@
 facing a camera, with vertex colours (COLOR_0, normalised bytes) and a 2 x 2 texture, in two
 materials that use every material extension pathlight reads with its textures: a velvet
 (KHR_materials_sheen, colour and roughness textures, one with KHR_texture_transform) and a
-coated, tinted, partly transmitting paint (KHR_materials_clearcoat with its textures,
+coated, tinted, partly transmitting paint (KHR_materials_clearcoat with its textures and normal map,
 KHR_materials_specular with its textures, KHR_materials_transmission with its texture,
 KHR_materials_volume, KHR_materials_ior). Self-contained: buffer and image are data: URIs.
 
@@ -100,7 +100,8 @@ def main():
              "extensions": {
                  "KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatTexture": texture,
                                              "clearcoatRoughnessFactor": 0.3,
-                                             "clearcoatRoughnessTexture": moved},
+                                             "clearcoatRoughnessTexture": moved,
+                                             "clearcoatNormalTexture": {"index": 0, "scale": 0.5}},
                  "KHR_materials_specular": {"specularFactor": 0.8, "specularTexture": texture,
                                             "specularColorFactor": [1, 0.9, 0.8],
                                             "specularColorTexture": texture},

@@ -207,6 +207,10 @@ pub const TEXTURE_CLEARCOAT_ROUGHNESS: u32 = TEXTURE_MODEL + 5;
 pub const TEXTURE_SHEEN_COLOR: u32 = TEXTURE_MODEL + 6;
 /// ... `KHR_materials_sheen`'s roughness texture (alpha).
 pub const TEXTURE_SHEEN_ROUGHNESS: u32 = TEXTURE_MODEL + 7;
+/// The normal map of a model's top layer, its coat (the metal-rough model's
+/// `KHR_materials_clearcoat` normal texture; linear), scaled by
+/// [`GpuMaterial::coat_normal_scale`]: the surface gives it a shading normal of its own.
+pub const TEXTURE_COAT_NORMAL: u32 = TEXTURE_MODEL + 8;
 
 /// [`GpuTextureSlot::wrap`] mode (2 bits per axis, u in the low bits): tile.
 pub const WRAP_REPEAT: u32 = 0;
@@ -265,8 +269,10 @@ pub struct GpuMaterial {
     pub textures: u32,
     /// Bit `TEXTURE_*` set when the material has that texture; 0 for none.
     pub texture_mask: u32,
+    /// Scale of the x and y of the coat's normal map ([`TEXTURE_COAT_NORMAL`]).
+    pub coat_normal_scale: f32,
     /// Padding.
-    pub pad: [u32; 2],
+    pub pad: u32,
 }
 const _: () = assert!(size_of::<GpuMaterial>() == 64);
 
@@ -285,7 +291,8 @@ impl GpuMaterial {
             params,
             textures: 0,
             texture_mask: 0,
-            pad: [0; 2],
+            coat_normal_scale: 1.0,
+            pad: 0,
         }
     }
 }

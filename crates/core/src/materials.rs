@@ -88,8 +88,8 @@ impl PackedMaterials {
             }
             AlphaMode::Blend => gpu.flags |= MATERIAL_BLEND,
         }
-        let (model, block, model_textures) = match &m.model {
-            Model::Lobes(lobes) => (MODEL_LOBES, lobes_block(lobes), vec![]),
+        let (model, block, model_textures, coat_normal_scale) = match &m.model {
+            Model::Lobes(lobes) => (MODEL_LOBES, lobes_block(lobes), vec![], 1.0),
             Model::MetalRough(pbr) => (
                 MODEL_METAL_ROUGH,
                 metal_rough_block(pbr),
@@ -97,8 +97,10 @@ impl PackedMaterials {
                     .into_iter()
                     .chain(pbr.textures.in_slot_order())
                     .collect(),
+                pbr.clearcoat_normal_scale,
             ),
         };
+        gpu.coat_normal_scale = coat_normal_scale;
         debug_assert!(block.len() <= MODEL_PARAMS);
         if block.len() > MODEL_PARAMS_SHORT {
             gpu.flags |= MATERIAL_LONG_BLOCK;

@@ -236,7 +236,8 @@ pub fn eval(m: &MetalRoughParams, color: Vec3A, s: &Surface, wo: Vec3A, wi: Vec3
         return base;
     }
     let sign = if wo.dot(s.ng) >= 0.0 { 1.0 } else { -1.0 };
-    let (ng, n) = (s.ng * sign, s.ns * sign);
+    // The coat's own shading normal.
+    let (ng, n) = (s.ng * sign, s.nc * sign);
     let weight = coat_weight(m, wo.dot(n));
     let mut out = BsdfEval {
         f: base.f * (1.0 - weight),
@@ -420,8 +421,11 @@ pub fn sample(
     if cos_o <= 0.0 {
         return INVALID;
     }
+    // The coat, about its own shading normal.
+    let nc = s.nc * sign;
+    let cos_c = wo.dot(nc);
     let coat = if m.clearcoat > 0.0 {
-        coat_weight(m, cos_o)
+        coat_weight(m, cos_c)
     } else {
         0.0
     };
@@ -429,10 +433,10 @@ pub fn sample(
         let alpha = m.clearcoat_roughness * m.clearcoat_roughness;
         if alpha < ALPHA_MIN {
             // A mirror coat: its weight over its probability is 1.
-            let wi = 2.0 * cos_o * n - wo;
+            let wi = 2.0 * cos_c * nc - wo;
             return delta(wi, Vec3A::ONE, wi.dot(ng) > 0.0);
         }
-        let frame = Frame::around(n);
+        let frame = Frame::around(nc);
         return match ggx_reflection(&frame, frame.to_local(wo), alpha, u) {
             Some(wi) => mixture_sample(m, color, s, wo, wi),
             None => INVALID,

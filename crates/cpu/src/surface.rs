@@ -5,7 +5,8 @@ use std::f32::consts::{PI, TAU};
 
 use glam::{Vec2, Vec3A};
 use pathlight_core::gpu_types::{
-    FLAG_CAPS, FLAG_FLAT, GpuMaterial, KIND_CYLINDER, KIND_QUAD, KIND_SPHERE, TEXTURE_NORMAL,
+    FLAG_CAPS, FLAG_FLAT, GpuMaterial, KIND_CYLINDER, KIND_QUAD, KIND_SPHERE, TEXTURE_COAT_NORMAL,
+    TEXTURE_NORMAL,
 };
 use pathlight_core::octahedral::{self, tangent_sign};
 
@@ -24,6 +25,9 @@ pub struct Surface {
     pub ng: Vec3A,
     /// Shading normal, in the hemisphere of `ng`.
     pub ns: Vec3A,
+    /// The shading normal of the material's coat: its own normal map
+    /// ([`TEXTURE_COAT_NORMAL`]) applied, else `ns`; in the hemisphere of `ng`.
+    pub nc: Vec3A,
     /// Texture coordinates.
     pub uv: Vec2,
     /// Material index.
@@ -32,10 +36,14 @@ pub struct Surface {
     pub color: Vec3A,
 }
 
-/// The shading normal bent by the material's normal map. Twin of WGSL `normal_mapped`.
+/// The shading normal bent by the material's normal map `which` ([`TEXTURE_NORMAL`] or
+/// [`TEXTURE_COAT_NORMAL`], its x and y scaled by `scale`). Twin of WGSL `normal_mapped`.
+#[allow(clippy::too_many_arguments)]
 fn normal_mapped(
     scene: &CpuScene,
     m: &GpuMaterial,
+    which: u32,
+    scale: f32,
     uv: Vec2,
     ns: Vec3A,
     tangent: Vec3A,
@@ -47,8 +55,8 @@ fn normal_mapped(
     }
     let tn = t.normalize();
     let b = ns.cross(tn) * sign;
-    let c = Vec3A::from(material_texture(scene, m, TEXTURE_NORMAL, uv).truncate()) * 2.0 - 1.0;
-    let n = tn * (c.x * m.normal_scale) + b * (c.y * m.normal_scale) + ns * c.z;
+    let c = Vec3A::from(material_texture(scene, m, which, uv).truncate()) * 2.0 - 1.0;
+    let n = tn * (c.x * scale) + b * (c.y * scale) + ns * c.z;
     if n.dot(n) < 1e-12 {
         return ns;
     }
@@ -92,6 +100,7 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
         position: p,
         ng: Vec3A::Y,
         ns: Vec3A::Y,
+        nc: Vec3A::Y,
         uv: Vec2::ZERO,
         material: o.material,
         color: Vec3A::ONE,
@@ -156,19 +165,53 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
                 s.ns = n.normalize();
             }
             let m = &scene.materials[o.material as usize];
+            let interpolated = s.ns;
+            let wo = -Vec3A::from(ray.dir);
+            let side = if wo.dot(s.ng) >= 0.0 { 1.0 } else { -1.0 };
+            let tangent = if m.texture_mask & ((1 << TEXTURE_NORMAL) | (1 << TEXTURE_COAT_NORMAL))
+                != 0
+            {
+                b0 * decode(v0.tangent) + hit.b1 * decode(v1.tangent) + hit.b2 * decode(v2.tangent)
+            } else {
+                Vec3A::ZERO
+            };
+            let sign = tangent_sign(v0.tangent);
             if has_texture(m, TEXTURE_NORMAL) {
-                let tangent = b0 * decode(v0.tangent)
-                    + hit.b1 * decode(v1.tangent)
-                    + hit.b2 * decode(v2.tangent);
-                s.ns = normal_mapped(scene, m, s.uv, s.ns, tangent, tangent_sign(v0.tangent));
-                let wo = -Vec3A::from(ray.dir);
-                let side = if wo.dot(s.ng) >= 0.0 { 1.0 } else { -1.0 };
+                s.ns = normal_mapped(
+                    scene,
+                    m,
+                    TEXTURE_NORMAL,
+                    m.normal_scale,
+                    s.uv,
+                    s.ns,
+                    tangent,
+                    sign,
+                );
                 s.ns = side * valid_reflection_normal(side * s.ng, wo, side * s.ns);
             }
             if s.ns.dot(s.ng) < 0.0 {
                 s.ns = -s.ns;
             }
+            s.nc = s.ns;
+            if has_texture(m, TEXTURE_COAT_NORMAL) {
+                s.nc = normal_mapped(
+                    scene,
+                    m,
+                    TEXTURE_COAT_NORMAL,
+                    m.coat_normal_scale,
+                    s.uv,
+                    interpolated,
+                    tangent,
+                    sign,
+                );
+                s.nc = side * valid_reflection_normal(side * s.ng, wo, side * s.nc);
+                if s.nc.dot(s.ng) < 0.0 {
+                    s.nc = -s.nc;
+                }
+            }
+            return s;
         }
     }
+    s.nc = s.ns;
     s
 }

@@ -232,6 +232,7 @@ fn surface() -> Surface {
         position: Vec3A::ZERO,
         ng: Vec3A::Z,
         ns: Vec3A::Z,
+        nc: Vec3A::Z,
         uv: Vec2::ZERO,
         material: 0,
         color: Vec3A::ONE,

@@ -151,7 +151,8 @@ fn eval_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, wi
     }
     let front = dot(wo, s.ng) >= 0.0;
     let ng = select(-s.ng, s.ng, front);
-    let n = select(-s.ns, s.ns, front);
+    // The coat's own shading normal.
+    let n = select(-s.nc, s.nc, front);
     let weight = mr_coat_weight(m, dot(wo, n));
     var out = BsdfEval(base.f * (1.0 - weight), base.pdf * (1.0 - weight));
     let alpha = m.clearcoat_roughness * m.clearcoat_roughness;
@@ -296,18 +297,21 @@ fn sample_metal_rough(m: MetalRoughParams, color: vec3f, s: Surface, wo: vec3f, 
     if cos_o <= 0.0 {
         return invalid_sample();
     }
+    // The coat, about its own shading normal.
+    let nc = select(-s.nc, s.nc, front);
+    let cos_c = dot(wo, nc);
     var coat = 0.0;
     if m.clearcoat > 0.0 {
-        coat = mr_coat_weight(m, cos_o);
+        coat = mr_coat_weight(m, cos_c);
     }
     if u_lobe < coat {
         let alpha_c = m.clearcoat_roughness * m.clearcoat_roughness;
         if alpha_c < ALPHA_MIN {
             // A mirror coat: its weight over its probability is 1.
-            let wi = 2.0 * cos_o * n - wo;
+            let wi = 2.0 * cos_c * nc - wo;
             return BsdfSample(wi, vec3f(1.0), 0.0, true, 1.0, dot(wi, ng) > 0.0);
         }
-        let frame_c = frame_around(n);
+        let frame_c = frame_around(nc);
         let r = ggx_reflection(frame_c, to_local(frame_c, wo), alpha_c, u);
         if !r.valid {
             return invalid_sample();

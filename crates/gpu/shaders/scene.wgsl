@@ -107,6 +107,7 @@ const TEXTURE_CLEARCOAT: u32 = 7u;
 const TEXTURE_CLEARCOAT_ROUGHNESS: u32 = 8u;
 const TEXTURE_SHEEN_COLOR: u32 = 9u;
 const TEXTURE_SHEEN_ROUGHNESS: u32 = 10u;
+const TEXTURE_COAT_NORMAL: u32 = 11u;
 const WRAP_REPEAT: u32 = 0u;
 const WRAP_CLAMP: u32 = 1u;
 const WRAP_MIRROR: u32 = 2u;
@@ -140,8 +141,9 @@ struct Material {
     params: u32,
     textures: u32,
     texture_mask: u32,
+    // Scale of the x and y of the coat's normal map (TEXTURE_COAT_NORMAL).
+    coat_normal_scale: f32,
     pad0: u32,
-    pad1: u32,
 }
 
 @group(0) @binding(0) var<storage, read> nodes: array<WideNode>;

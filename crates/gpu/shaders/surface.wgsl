@@ -15,6 +15,9 @@ struct Surface {
     ng: vec3f,
     // Shading normal, in the same hemisphere as `ng`.
     ns: vec3f,
+    // The shading normal of the material's coat: its own normal map (TEXTURE_COAT_NORMAL)
+    // applied, else `ns`; in the same hemisphere as `ng`.
+    nc: vec3f,
     uv: vec2f,
     material: u32,
     // The vertex colour (white but on meshes with COLOR_0), multiplying the base colour.
@@ -39,18 +42,19 @@ fn decode_unit(code: u32) -> vec3f {
     return normalize(vec3f(e.x + select(t, -t, e.x >= 0.0), e.y + select(t, -t, e.y >= 0.0), z));
 }
 
-// The shading normal `ns` bent by material `m`'s normal map at `uv`, in the frame of the
+// The shading normal `ns` bent by material `m`'s normal map `which` (TEXTURE_NORMAL or
+// TEXTURE_COAT_NORMAL, its x and y scaled by `scale`) at `uv`, in the frame of the
 // corner-interpolated tangent `tangent` (bitangent cross(ns, tangent) * sign).
 // CPU twin: `normal_mapped`.
-fn normal_mapped(m: Material, uv: vec2f, ns: vec3f, tangent: vec3f, sign: f32) -> vec3f {
+fn normal_mapped(m: Material, which: u32, scale: f32, uv: vec2f, ns: vec3f, tangent: vec3f, sign: f32) -> vec3f {
     let t = tangent - dot(tangent, ns) * ns;
     if dot(t, t) < 1e-12 {
         return ns;
     }
     let tn = normalize(t);
     let b = cross(ns, tn) * sign;
-    let c = material_texture(m, TEXTURE_NORMAL, uv).xyz * 2.0 - 1.0;
-    let n = tn * (c.x * m.normal_scale) + b * (c.y * m.normal_scale) + ns * c.z;
+    let c = material_texture(m, which, uv).xyz * 2.0 - 1.0;
+    let n = tn * (c.x * scale) + b * (c.y * scale) + ns * c.z;
     if dot(n, n) < 1e-12 {
         return ns;
     }
@@ -82,7 +86,7 @@ fn valid_reflection_normal(ng: vec3f, wo: vec3f, n: vec3f) -> vec3f {
 fn surface_at(hit: Hit, ray: Ray) -> Surface {
     let o = objects[hit.object];
     let p = ray.origin + hit.t * ray.dir;
-    var s = Surface(p, vec3f(0.0, 1.0, 0.0), vec3f(0.0, 1.0, 0.0), vec2f(0.0), o.material, vec3f(1.0));
+    var s = Surface(p, vec3f(0.0, 1.0, 0.0), vec3f(0.0, 1.0, 0.0), vec3f(0.0, 1.0, 0.0), vec2f(0.0), o.material, vec3f(1.0));
     switch o.kind {
         case KIND_QUAD: {
             s.ng = normalize(cross(o.b.xyz, o.c.xyz));
@@ -131,17 +135,31 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
                 s.ns = normalize(n);
             }
             let m = materials[o.material];
+            let interpolated = s.ns;
+            var tangent = vec3f(0.0);
+            let wo = -ray.dir;
+            let side = select(-1.0, 1.0, dot(wo, s.ng) >= 0.0);
+            if (m.texture_mask & ((1u << TEXTURE_NORMAL) | (1u << TEXTURE_COAT_NORMAL))) != 0u {
+                tangent = b0 * decode_unit(v0.tangent) + hit.b1 * decode_unit(v1.tangent) + hit.b2 * decode_unit(v2.tangent);
+            }
             if has_texture(m, TEXTURE_NORMAL) {
-                let tangent = b0 * decode_unit(v0.tangent) + hit.b1 * decode_unit(v1.tangent) + hit.b2 * decode_unit(v2.tangent);
-                s.ns = normal_mapped(m, s.uv, s.ns, tangent, tangent_sign(v0.tangent));
-                let wo = -ray.dir;
-                let side = select(-1.0, 1.0, dot(wo, s.ng) >= 0.0);
+                s.ns = normal_mapped(m, TEXTURE_NORMAL, m.normal_scale, s.uv, s.ns, tangent, tangent_sign(v0.tangent));
                 s.ns = side * valid_reflection_normal(side * s.ng, wo, side * s.ns);
             }
             if dot(s.ns, s.ng) < 0.0 {
                 s.ns = -s.ns;
             }
+            s.nc = s.ns;
+            if has_texture(m, TEXTURE_COAT_NORMAL) {
+                s.nc = normal_mapped(m, TEXTURE_COAT_NORMAL, m.coat_normal_scale, s.uv, interpolated, tangent, tangent_sign(v0.tangent));
+                s.nc = side * valid_reflection_normal(side * s.ng, wo, side * s.nc);
+                if dot(s.nc, s.ng) < 0.0 {
+                    s.nc = -s.nc;
+                }
+            }
+            return s;
         }
     }
+    s.nc = s.ns;
     return s;
 }

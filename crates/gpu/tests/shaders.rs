@@ -159,7 +159,8 @@ fn host_structs_match_their_wgsl_declarations() {
             normal_scale,
             params,
             textures,
-            texture_mask
+            texture_mask,
+            coat_normal_scale
         ]
     );
     assert_layout!(
@@ -278,6 +279,7 @@ fn host_constants_match_their_wgsl_declarations() {
         ),
         ("TEXTURE_SHEEN_COLOR", t::TEXTURE_SHEEN_COLOR),
         ("TEXTURE_SHEEN_ROUGHNESS", t::TEXTURE_SHEEN_ROUGHNESS),
+        ("TEXTURE_COAT_NORMAL", t::TEXTURE_COAT_NORMAL),
         ("WRAP_REPEAT", t::WRAP_REPEAT),
         ("WRAP_CLAMP", t::WRAP_CLAMP),
         ("WRAP_MIRROR", t::WRAP_MIRROR),

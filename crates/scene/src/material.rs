@@ -291,6 +291,8 @@ pub struct MetalRough {
     pub clearcoat: f32,
     /// The coat's perceptual roughness (`clearcoatRoughnessFactor`).
     pub clearcoat_roughness: f32,
+    /// Scale of the x and y of the coat's normal map (`clearcoatNormalTexture.scale`).
+    pub clearcoat_normal_scale: f32,
     /// Absorption coefficient per unit length (linear RGB) inside a solid (not `thin`)
     /// material: light crossing it keeps `exp(-attenuation d)` over a distance d
     /// (`KHR_materials_volume`'s `-ln(attenuationColor) / attenuationDistance`); zero: clear.
@@ -317,6 +319,8 @@ pub struct LayerTextures {
     pub clearcoat: Option<TextureRef>,
     /// `KHR_materials_clearcoat`: roughness in green.
     pub clearcoat_roughness: Option<TextureRef>,
+    /// `KHR_materials_clearcoat`: the coat's own tangent-space normal map.
+    pub clearcoat_normal: Option<TextureRef>,
     /// `KHR_materials_sheen`: colour (sRGB).
     pub sheen_color: Option<TextureRef>,
     /// `KHR_materials_sheen`: roughness in alpha.
@@ -331,12 +335,13 @@ impl LayerTextures {
         specular_color: None,
         clearcoat: None,
         clearcoat_roughness: None,
+        clearcoat_normal: None,
         sheen_color: None,
         sheen_roughness: None,
     };
 
     /// In the order of the kernels' texture slots (`TEXTURE_TRANSMISSION` onwards).
-    pub fn in_slot_order(&self) -> [Option<TextureRef>; 7] {
+    pub fn in_slot_order(&self) -> [Option<TextureRef>; 8] {
         [
             self.transmission,
             self.specular,
@@ -345,6 +350,7 @@ impl LayerTextures {
             self.clearcoat_roughness,
             self.sheen_color,
             self.sheen_roughness,
+            self.clearcoat_normal,
         ]
     }
 
@@ -356,6 +362,7 @@ impl LayerTextures {
             self.specular_color.as_mut(),
             self.clearcoat.as_mut(),
             self.clearcoat_roughness.as_mut(),
+            self.clearcoat_normal.as_mut(),
             self.sheen_color.as_mut(),
             self.sheen_roughness.as_mut(),
         ]
@@ -378,6 +385,7 @@ impl MetalRough {
         specular_color: Vec3::ONE,
         clearcoat: 0.0,
         clearcoat_roughness: 0.0,
+        clearcoat_normal_scale: 1.0,
         attenuation: Vec3::ZERO,
         sheen_color: Vec3::ZERO,
         sheen_roughness: 0.0,

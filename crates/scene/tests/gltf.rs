@@ -613,7 +613,8 @@ fn sheen_and_the_extensions_textures_are_read() {
             "sheenColorTexture": {"index": 0}, "sheenRoughnessTexture": {"index": 0,
             "extensions": {"KHR_texture_transform": {"offset": [0.5, 0], "scale": [2, 2]}}}},
         "KHR_materials_clearcoat": {"clearcoatFactor": 0.6, "clearcoatTexture": {"index": 0},
-            "clearcoatRoughnessTexture": {"index": 0}},
+            "clearcoatRoughnessTexture": {"index": 0},
+            "clearcoatNormalTexture": {"index": 0, "scale": 0.5}},
         "KHR_materials_transmission": {"transmissionFactor": 0.5,
             "transmissionTexture": {"index": 0}},
         "KHR_materials_specular": {"specularTexture": {"index": 0},
@@ -631,6 +632,7 @@ fn sheen_and_the_extensions_textures_are_read() {
     };
     assert_eq!(m.sheen_color, Vec3::new(0.9, 0.5, 0.1));
     assert_eq!((m.sheen_roughness, m.clearcoat), (0.4, 0.6));
+    assert_eq!(m.clearcoat_normal_scale, 0.5);
     let t = m.textures;
     for (name, slot) in [
         ("transmission", t.transmission),
@@ -638,6 +640,7 @@ fn sheen_and_the_extensions_textures_are_read() {
         ("specular colour", t.specular_color),
         ("clear coat", t.clearcoat),
         ("clear coat roughness", t.clearcoat_roughness),
+        ("clear coat normal", t.clearcoat_normal),
         ("sheen colour", t.sheen_color),
     ] {
         let slot = slot.unwrap_or_else(|| panic!("no {name} texture"));

@@ -94,21 +94,17 @@ impl<'a> Materials<'a> {
         let [
             coat_texture,
             coat_roughness_texture,
+            coat_normal_texture,
             sheen_color_texture,
             sheen_roughness_texture,
         ] = [
             (&coat, "clearcoatTexture"),
             (&coat, "clearcoatRoughnessTexture"),
+            (&coat, "clearcoatNormalTexture"),
             (&sheen, "sheenColorTexture"),
             (&sheen, "sheenRoughnessTexture"),
         ]
         .map(|(layer, key)| layer.texture(file_textures, key));
-        if coat.has("clearcoatNormalTexture") {
-            log::warn!(
-                "{}: {element}: the clear coat's normal map is ignored (the coat follows the base's normal)",
-                files.path.display()
-            );
-        }
         let textures = LayerTextures {
             transmission: reference(
                 self,
@@ -133,6 +129,7 @@ impl<'a> Materials<'a> {
             )?,
             clearcoat: reference(self, coat_texture?)?,
             clearcoat_roughness: reference(self, coat_roughness_texture?)?,
+            clearcoat_normal: reference(self, coat_normal_texture?)?,
             sheen_color: reference(self, sheen_color_texture?)?,
             sheen_roughness: reference(self, sheen_roughness_texture?)?,
         };
@@ -180,6 +177,7 @@ impl<'a> Materials<'a> {
                 .map_or(Vec3::ONE, |s| Vec3::from(s.specular_color_factor())),
             clearcoat: coat.number("clearcoatFactor", 0.0),
             clearcoat_roughness: coat.number("clearcoatRoughnessFactor", 0.0),
+            clearcoat_normal_scale: coat.number("clearcoatNormalTexture/scale", 1.0),
             attenuation,
             sheen_color,
             sheen_roughness: sheen.number("sheenRoughnessFactor", 0.0),
@@ -204,6 +202,7 @@ impl<'a> Materials<'a> {
             metal_rough.specular_color.z,
             metal_rough.clearcoat,
             metal_rough.clearcoat_roughness,
+            metal_rough.clearcoat_normal_scale.abs(),
             metal_rough.sheen_color.x,
             metal_rough.sheen_color.y,
             metal_rough.sheen_color.z,
@@ -217,7 +216,7 @@ impl<'a> Materials<'a> {
         }
         let needs = Needs {
             uv_set,
-            tangents: normal_texture.is_some(),
+            tangents: normal_texture.is_some() || textures.clearcoat_normal.is_some(),
         };
         let material = Material {
             name: material
@@ -346,15 +345,10 @@ impl<'f> Layer<'f> {
         })
     }
 
-    /// Whether it has `key`.
-    fn has(&self, key: &str) -> bool {
-        self.value.is_some_and(|v| v.get(key).is_some())
-    }
-
-    /// Number `key`, `default` when absent; NaN (refused with the other factors) when it is
-    /// not a number.
+    /// Number `key` (a path below the extension's object: `a/b`), `default` when absent; NaN
+    /// (refused with the other factors) when it is not a number.
     fn number(&self, key: &str, default: f32) -> f32 {
-        match self.value.and_then(|v| v.get(key)) {
+        match self.value.and_then(|v| v.pointer(&format!("/{key}"))) {
             None => default,
             Some(v) => v.as_f64().map_or(f32::NAN, |f| f as f32),
         }
