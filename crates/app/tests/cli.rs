@@ -816,3 +816,64 @@ fn a_gltf_file_with_every_supported_material_extension_renders_without_warnings(
     assert!(paint[2] > paint[0], "the paint is not blue: {paint:?}");
     assert!((sky[1] - 0.8).abs() < 0.05, "the sky: {sky:?}");
 }
+
+/// A glTF file placing one triangle 400 times needs about 400 x 320 bytes: a
+/// `PATHLIGHT_MEMORY_LIMIT` below that refuses it before reading it, naming the file, the
+/// meshes, placements, triangles and bytes (exit status 1, no abort); one above renders it;
+/// a limit that is not a size is refused naming the variable.
+#[test]
+fn a_gltf_too_large_for_the_memory_limit_is_refused_saying_how_large() {
+    let dir = tempfile::tempdir().unwrap();
+    let positions: [f32; 9] = [-1.0, -1.0, 0.0, 1.0, -1.0, 0.0, 0.0, 1.0, 0.0];
+    let bytes: Vec<u8> = positions.iter().flat_map(|v| v.to_le_bytes()).collect();
+    std::fs::write(dir.path().join("panel.bin"), bytes).unwrap();
+    let nodes: Vec<String> = (0..400)
+        .map(|i| format!(r#"{{"mesh": 0, "translation": [{}, 0, -5]}}"#, i % 20))
+        .collect();
+    let gltf = dir.path().join("many.gltf");
+    std::fs::write(
+        &gltf,
+        format!(
+            r#"{{"asset": {{"version": "2.0"}}, "scene": 0,
+            "scenes": [{{"nodes": [{}]}}], "nodes": [{}],
+            "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}}}]}}],
+            "buffers": [{{"byteLength": 36, "uri": "panel.bin"}}],
+            "bufferViews": [{{"buffer": 0, "byteLength": 36}}],
+            "accessors": [{{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                "min": [-1, -1, 0], "max": [1, 1, 0]}}]}}"#,
+            (0..400)
+                .map(|i| i.to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+            nodes.join(", ")
+        ),
+    )
+    .unwrap();
+    let render = |limit: &str| {
+        Command::new(env!("CARGO_BIN_EXE_pathlight"))
+            .args(["render", gltf.to_str().unwrap(), "--spp", "1"])
+            .args(SMALL_ON_CPU)
+            .arg("-o")
+            .arg(dir.path().join("many.png"))
+            .env("PATHLIGHT_MEMORY_LIMIT", limit)
+            .current_dir(repo())
+            .output()
+            .unwrap()
+    };
+    let refused = render("64K");
+    let err = stderr(&refused);
+    assert_eq!(refused.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("many.gltf: scene 0: places 1 meshes 400 times: 400 triangles need about 125.0 KiB (about 320 bytes each), more than the 64.0 KiB PATHLIGHT_MEMORY_LIMIT allows"),
+        "{err}"
+    );
+    let rendered = render("1M");
+    assert!(rendered.status.success(), "{}", stderr(&rendered));
+    let nonsense = render("plenty");
+    let err = stderr(&nonsense);
+    assert_eq!(nonsense.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("PATHLIGHT_MEMORY_LIMIT=\"plenty\" is not a number of bytes"),
+        "{err}"
+    );
+}

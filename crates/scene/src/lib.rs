@@ -12,6 +12,7 @@ pub mod gltf_file;
 pub mod light;
 pub mod load;
 pub mod material;
+pub mod memory;
 pub mod mesh;
 pub mod revolve;
 pub mod settings;

@@ -136,6 +136,7 @@ pub fn load_gltf(path: &Path, transform: Mat4) -> Result<GltfModel, SceneError> 
     for node in scene.nodes() {
         count_uses(&node, &mut Vec::new(), &mut walk.uses);
     }
+    check_memory(&files, &document, &scene, &walk.uses)?;
     for node in scene.nodes() {
         walk.node(&node, transform)?;
     }
@@ -195,6 +196,45 @@ struct Walk<'a> {
     /// Per (mesh, primitive), its triangles in the mesh's own space (`None`: skipped), read
     /// once and kept while further placements of the mesh are to come.
     read: HashMap<(usize, usize), Option<TriangleMesh>>,
+}
+
+/// Refuses a scene whose placed triangles (`uses`: placements per mesh) need more memory
+/// than this process may use ([`crate::memory`]), before any is read.
+fn check_memory(
+    files: &Files,
+    document: &gltf::Document,
+    scene: &gltf::Scene,
+    uses: &HashMap<usize, usize>,
+) -> Result<(), SceneError> {
+    let triangles_of = |mesh: gltf::Mesh| -> u64 {
+        mesh.primitives()
+            .map(|p| {
+                let count = p
+                    .indices()
+                    .or_else(|| p.get(&gltf::Semantic::Positions))
+                    .map_or(0, |a| a.count() as u64);
+                match p.mode() {
+                    gltf::mesh::Mode::Triangles => count / 3,
+                    gltf::mesh::Mode::TriangleStrip | gltf::mesh::Mode::TriangleFan => {
+                        count.saturating_sub(2)
+                    }
+                    _ => 0,
+                }
+            })
+            .sum()
+    };
+    let mut triangles = 0u64;
+    for mesh in document.meshes() {
+        let placed = uses.get(&mesh.index()).copied().unwrap_or(0) as u64;
+        triangles = triangles.saturating_add(placed.saturating_mul(triangles_of(mesh)));
+    }
+    crate::memory::check_triangles(triangles).map_err(|message| {
+        let placements: usize = uses.values().sum();
+        files.error(
+            &format!("scene {}", scene.index()),
+            format!("places {} meshes {placements} times: {message}", uses.len()),
+        )
+    })
 }
 
 /// Counts into `uses` how often each mesh is placed under `node` (a node reached again
