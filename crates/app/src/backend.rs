@@ -242,28 +242,10 @@ impl Device {
     }
 }
 
-/// The variable naming the CPU backend's level, for comparing levels on one machine.
-pub const CPU_LEVEL_VARIABLE: &str = "PATHLIGHT_CPU_LEVEL";
-
-/// The level the CPU backend runs: the best this CPU has, or the one [`CPU_LEVEL_VARIABLE`]
-/// names when set and not empty (refused, with the levels there are, when this CPU cannot
-/// run it).
+/// The level the CPU backend runs: the best this CPU has, or the one
+/// [`pathlight_cpu::LEVEL_VARIABLE`] names.
 pub fn cpu_level() -> anyhow::Result<InstructionSet> {
-    let name = std::env::var_os(CPU_LEVEL_VARIABLE).unwrap_or_default();
-    let name = name.to_string_lossy();
-    if name.is_empty() {
-        return Ok(InstructionSet::best());
-    }
-    InstructionSet::named(&name).ok_or_else(|| {
-        let levels: Vec<&str> = InstructionSet::supported()
-            .iter()
-            .map(|level| level.name())
-            .collect();
-        anyhow::anyhow!(
-            "{CPU_LEVEL_VARIABLE}={name}: this CPU runs the levels {}",
-            levels.join(", ")
-        )
-    })
+    Ok(InstructionSet::from_environment()?)
 }
 
 /// The CPU backend renderer of `prepared` as `scene`'s camera and settings ask, running

@@ -68,29 +68,11 @@ pub fn check_writable(path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// `film` as an 8-bit PNG, each channel mapped by `encode`.
-fn encode_png(film: &Film, encode: impl Fn(f32) -> f32) -> anyhow::Result<Vec<u8>> {
-    use image::ImageEncoder as _;
-    let pixels: Vec<u8> = film
-        .pixels
-        .iter()
-        .flat_map(|p| p.map(|c| (encode(c).clamp(0.0, 1.0) * 255.0 + 0.5) as u8))
-        .collect();
-    let mut bytes = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut bytes).write_image(
-        &pixels,
-        film.width,
-        film.height,
-        image::ExtendedColorType::Rgb8,
-    )?;
-    Ok(bytes)
-}
-
 /// The film encoded in `format` (an image format).
 fn encode(film: &Film, format: Format) -> anyhow::Result<Vec<u8>> {
     match format {
         Format::State => bail!("a film has no state: only a render's sums make one"),
-        Format::Png => encode_png(film, linear_to_srgb),
+        Format::Png => Ok(film.encode_png(linear_to_srgb)?),
         Format::Exr => Ok(film.encode_exr()?),
     }
 }
@@ -206,8 +188,8 @@ pub fn write_images(images: &Images, path: &Path) -> anyhow::Result<()> {
             for (aov, film) in &images.aovs {
                 let sibling = sibling_path(path, aov.name());
                 let bytes = match aov {
-                    Aov::Albedo => encode_png(film, linear_to_srgb),
-                    Aov::Normal => encode_png(film, |n| (n + 1.0) * 0.5),
+                    Aov::Albedo => film.encode_png(linear_to_srgb),
+                    Aov::Normal => film.encode_png(|n| (n + 1.0) * 0.5),
                 }
                 .with_context(|| format!("cannot encode {}", sibling.display()))?;
                 replace_file(&sibling, &bytes)

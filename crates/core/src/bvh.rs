@@ -23,15 +23,31 @@ pub(crate) struct BinaryTree {
     pub primitive_indices: Vec<u32>,
 }
 
+/// Above this many primitives the tree is built with obvhs' fast preset (a narrower
+/// nearest-neighbour search, fewer reinsertions), below with its medium one. On a 4M-triangle
+/// mesh the fast build saved 0.4-1.2 s of a 7 s render at the same CPU samples/s
+/// (BENCHMARKS.md); scenes this small build in a fraction of a second either way.
+const FAST_BUILD_ABOVE: usize = 500_000;
+
+/// obvhs' build preset for `count` primitives.
+fn preset(count: usize) -> BvhBuildParams {
+    if count > FAST_BUILD_ABOVE {
+        BvhBuildParams::fast_build()
+    } else {
+        BvhBuildParams::medium_build()
+    }
+}
+
 /// Builds the binary tree over `bounds` (not empty) with obvhs' medium preset
-/// (SAH-quality PLOC with reinsertion), on every core. Primitives with the very same box
-/// share one leaf: PLOC pairs nearest neighbours and breaks ties one way, so n identical
-/// boxes made a chain n/3 deep in O(n^2) (20,000 coincident triangles: 11 s).
+/// (SAH-quality PLOC with reinsertion; its fast one for large inputs), on every core.
+/// Primitives with the very same box share one leaf: PLOC pairs nearest neighbours and
+/// breaks ties one way, so n identical boxes made a chain n/3 deep in O(n^2) (20,000
+/// coincident triangles: 11 s).
 pub(crate) fn build_binary(bounds: &[Aabb]) -> BinaryTree {
     let groups = IdenticalBoxes::of(bounds);
     let mut build_time = Duration::ZERO;
     if groups.count() == bounds.len() {
-        let tree = build_bvh2(bounds, BvhBuildParams::medium_build(), &mut build_time);
+        let tree = build_bvh2(bounds, preset(bounds.len()), &mut build_time);
         return BinaryTree {
             nodes: tree.nodes,
             primitive_indices: tree.primitive_indices,
@@ -40,7 +56,7 @@ pub(crate) fn build_binary(bounds: &[Aabb]) -> BinaryTree {
     let unique: Vec<Aabb> = (0..groups.count())
         .map(|g| bounds[groups.members_of(g as u32)[0] as usize])
         .collect();
-    let tree = build_bvh2(&unique, BvhBuildParams::medium_build(), &mut build_time);
+    let tree = build_bvh2(&unique, preset(unique.len()), &mut build_time);
     // Each leaf slot of the tree over unique boxes becomes the slots of its group.
     let mut slot_starts = Vec::with_capacity(tree.primitive_indices.len() + 1);
     let mut primitive_indices = Vec::with_capacity(bounds.len());

@@ -141,6 +141,25 @@ impl Film {
         })
     }
 
+    /// The film as an 8-bit RGB PNG in memory, each channel mapped by `encode` (the sRGB
+    /// curve for an image, `(n + 1) / 2` for a normal) and clamped to [0, 1].
+    pub fn encode_png(&self, encode: impl Fn(f32) -> f32) -> Result<Vec<u8>, image::ImageError> {
+        use image::ImageEncoder as _;
+        let pixels: Vec<u8> = self
+            .pixels
+            .iter()
+            .flat_map(|p| p.map(|c| (encode(c).clamp(0.0, 1.0) * 255.0 + 0.5) as u8))
+            .collect();
+        let mut bytes = Vec::new();
+        image::codecs::png::PngEncoder::new(&mut bytes).write_image(
+            &pixels,
+            self.width,
+            self.height,
+            image::ExtendedColorType::Rgb8,
+        )?;
+        Ok(bytes)
+    }
+
     /// The film encoded as 32-bit float linear RGB OpenEXR, in memory (written to disk by
     /// the caller, who decides how to replace a file safely).
     pub fn encode_exr(&self) -> Result<Vec<u8>, exr::error::Error> {

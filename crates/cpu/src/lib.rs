@@ -41,7 +41,7 @@ use pathlight_scene::{Camera, RenderSettings};
 use rayon::prelude::*;
 
 pub use crate::cpu_scene::CpuScene;
-pub use crate::row::InstructionSet;
+pub use crate::row::{InstructionSet, LEVEL_VARIABLE, UnknownLevel};
 use crate::row::{RowJob, RowSums, Tally, render_row_with};
 pub use crate::tracer::Tracer;
 

@@ -137,6 +137,19 @@ fn finish(path: &Path, row: &mut RowSums, x: usize) -> Tally {
     }
 }
 
+/// The variable naming the CPU backend's level, for comparing levels on one machine.
+pub const LEVEL_VARIABLE: &str = "PATHLIGHT_CPU_LEVEL";
+
+/// A [`LEVEL_VARIABLE`] naming a level this CPU cannot run.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{LEVEL_VARIABLE}={name}: this CPU runs the levels {levels}")]
+pub struct UnknownLevel {
+    /// The level named.
+    pub name: String,
+    /// The levels this CPU runs, comma-separated.
+    pub levels: String,
+}
+
 /// The instruction set a row renderer is compiled for: `render_row` is compiled once per
 /// level and the best one the CPU has is chosen at run time (AVX2 and FMA give the scalar
 /// code three-operand SSE/AVX encodings, BMI2 shifts, GFNI one-instruction bit reversal;
@@ -181,6 +194,25 @@ impl InstructionSet {
     /// The best level this CPU can run.
     pub fn best() -> Self {
         Self::supported().pop().unwrap_or(Self::Baseline)
+    }
+
+    /// The level the CPU backend runs: the best this CPU has, or the one
+    /// [`LEVEL_VARIABLE`] names when set and not empty (refused, with the levels there are,
+    /// when this CPU cannot run it).
+    pub fn from_environment() -> Result<Self, UnknownLevel> {
+        let name = std::env::var_os(LEVEL_VARIABLE).unwrap_or_default();
+        let name = name.to_string_lossy();
+        if name.is_empty() {
+            return Ok(Self::best());
+        }
+        Self::named(&name).ok_or_else(|| UnknownLevel {
+            name: name.into_owned(),
+            levels: Self::supported()
+                .iter()
+                .map(|level| level.name())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })
     }
 
     /// The level this CPU can run whose [`name`](Self::name) is `name`.

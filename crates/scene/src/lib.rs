@@ -27,7 +27,7 @@ pub use environment::{Environment, EnvironmentMap, HdrImage};
 pub use error::{RangeError, SceneError};
 pub use gltf_file::{GREY_SKY, GltfModel, gltf_scene, load_gltf};
 pub use light::{Cone, Light, LightKind};
-pub use load::{SceneSource, load_scene, load_scene_file};
+pub use load::{SceneSource, load_materials, load_scene, load_scene_file};
 pub use material::{
     AlphaMode, Conductor, LayerTextures, Lobes, Material, MetalRough, Model, TextureRef, Wrap,
 };

@@ -7,7 +7,7 @@ use glam::Vec3;
 use pathlight_scene::settings::{MAX_RESOLUTION, MAX_SPP};
 use pathlight_scene::{
     Cone, Environment, LightKind, Lobes, Model, Scene, SceneError, SceneSource, Shape,
-    default_scene, load_scene, load_scene_file,
+    default_scene, load_materials, load_scene, load_scene_file,
 };
 
 fn repo() -> PathBuf {
@@ -567,4 +567,28 @@ fn bad_lights_are_refused_with_line_and_key() {
         let message = error(body);
         assert!(message.contains(wanted), "{body:?}: {message}");
     }
+}
+
+#[test]
+fn materials_load_alone_as_the_whole_scene_loads_them() {
+    // The default scene: a textured material among plain ones, and placed shapes after.
+    let source = SceneSource {
+        name: "<default scene>".into(),
+        text: default_scene::TEXT,
+        base_dir: PathBuf::new(),
+        embedded: default_scene::ASSETS,
+    };
+    let scene = load_scene(&source).unwrap();
+    let materials = load_materials(&source).unwrap();
+    assert_eq!(materials, scene.materials);
+    assert!(materials.iter().any(|m| m.texture.is_some()));
+    // A bad value is refused as the whole scene's loader refuses it.
+    let text = default_scene::TEXT.replace("[materials.floor]", "[materials.floor]\nior = -1");
+    let bad = SceneSource {
+        text: &text,
+        ..source
+    };
+    let message = load_materials(&bad).unwrap_err().to_string();
+    assert_eq!(message, load_scene(&bad).unwrap_err().to_string());
+    assert!(message.contains("materials.floor.ior"), "{message}");
 }

@@ -22,7 +22,7 @@ use crate::settings::{
     check_max_depth, check_resolution, check_spp,
 };
 use crate::texture::srgb_to_linear;
-use crate::{Camera, Environment, HdrImage, RenderSettings, Sampler, Scene, Texture};
+use crate::{Camera, Environment, HdrImage, Material, RenderSettings, Sampler, Scene, Texture};
 
 /// Where a scene's text and assets come from.
 #[derive(Debug, Clone)]
@@ -53,7 +53,25 @@ pub fn load_scene_file(path: &Path) -> Result<Scene, SceneError> {
 
 /// Parses and builds a scene.
 pub fn load_scene(source: &SceneSource) -> Result<Scene, SceneError> {
-    let desc: SceneDesc = toml::from_str(source.text).map_err(|err| {
+    Builder::new(source).build(parse(source)?)
+}
+
+/// The materials of a scene's text alone, built as [`load_scene`] builds them: in the same
+/// order, with the same texture ids where the texture paths are the same. For changing the
+/// materials of a loaded scene without reading its shapes again (the materials placed glTF
+/// files bring are not among them).
+pub fn load_materials(source: &SceneSource) -> Result<Vec<Material>, SceneError> {
+    let desc = parse(source)?;
+    let mut builder = Builder::new(source);
+    desc.materials
+        .iter()
+        .map(|(name, material)| builder.material(name, material, desc.color_space))
+        .collect()
+}
+
+/// The scene description of a scene's text, or the syntax error with its line and column.
+fn parse(source: &SceneSource) -> Result<SceneDesc, SceneError> {
+    toml::from_str(source.text).map_err(|err| {
         let (line, column) = err
             .span()
             .map(|span| line_column(source.text, span.start))
@@ -64,13 +82,7 @@ pub fn load_scene(source: &SceneSource) -> Result<Scene, SceneError> {
             column,
             message: err.message().trim().to_owned(),
         }
-    })?;
-    Builder {
-        source,
-        textures: Vec::new(),
-        texture_ids: HashMap::new(),
-    }
-    .build(desc)
+    })
 }
 
 /// 1-based line and column of a byte offset.
@@ -85,6 +97,16 @@ struct Builder<'a, 'b> {
     source: &'a SceneSource<'b>,
     textures: Vec<Texture>,
     texture_ids: HashMap<String, u32>,
+}
+
+impl<'a, 'b> Builder<'a, 'b> {
+    fn new(source: &'a SceneSource<'b>) -> Self {
+        Self {
+            source,
+            textures: Vec::new(),
+            texture_ids: HashMap::new(),
+        }
+    }
 }
 
 impl Builder<'_, '_> {
