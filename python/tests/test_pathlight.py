@@ -259,3 +259,11 @@ def test_rendering_lets_other_python_threads_run():
     # With the GIL held through each backend step (a fraction of a second) this thread would
     # wake a few times per step; released, it wakes every millisecond or so.
     assert ticks > 100 * seconds, f"{ticks} wake-ups in {seconds:.2f} s"
+
+
+def test_the_example_sweep_runs(tmp_path):
+    out = tmp_path / "sweep.png"
+    subprocess.run([sys.executable, str(REPO / "examples" / "python" / "roughness_sweep.py"),
+                    "--spp", "1", "--size", "16", "--roughness", "0.1", "0.9", "--backend",
+                    "cpu", "-o", str(out)], check=True, capture_output=True)
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

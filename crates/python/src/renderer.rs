@@ -21,7 +21,11 @@ use crate::files::{read_state, write_state};
 use crate::scene::{Scene, camera_dict, changed_camera};
 
 /// A progressive render of a scene (a copy of it, taken when the renderer is made: changes
-/// to the renderer's camera and materials do not touch the scene's).
+/// to the renderer's camera and materials do not touch the scene's). Arguments left out take
+/// the scene's values; `backend` is "auto" (a hardware GPU when there is one, else the CPU
+/// backend), "gpu" or "cpu"; `aovs` accumulates the albedo and normal images too;
+/// `first_sample` starts the render at that sample index (one shard of a render made of
+/// several, summed by `merge`).
 #[pyclass(module = "pathlight", name = "Renderer")]
 pub struct Renderer {
     scene: Scene,
@@ -86,10 +90,7 @@ impl Renderer {
 
 #[pymethods]
 impl Renderer {
-    /// A progressive render of `scene`; arguments left out take the scene's values.
-    /// `backend` is "auto" (a hardware GPU when there is one, else the CPU backend), "gpu"
-    /// or "cpu"; `aovs` accumulates the albedo and normal images too; `first_sample` starts
-    /// the render at that sample index (a shard of a render made of several).
+    /// A progressive render of `scene` (see the class).
     #[new]
     #[pyo3(signature = (scene, *, backend = "auto", seed = None, width = None, height = None, max_depth = None, aovs = false, first_sample = 0))]
     #[expect(clippy::too_many_arguments, reason = "Python keyword arguments")]

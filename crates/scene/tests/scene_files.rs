@@ -51,8 +51,8 @@ fn shipped_scenes_load() {
         }
     }
     assert_eq!(
-        found, 24,
-        "default + outdoor + nine reference scenes + 13 furnace rings"
+        found, 25,
+        "default + outdoor + layers + nine reference scenes + 13 furnace rings"
     );
 }
 
