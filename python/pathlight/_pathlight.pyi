@@ -53,6 +53,18 @@ class Scene:
         """Moves, turns or resizes the camera; keys left out keep their values. A focus
         distance that was the distance to ``look_at`` follows a moved camera or target.
         Raises ValueError for a camera the scene file would refuse."""
+    def set_environment(
+        self,
+        *,
+        map: Optional[PathLike] = None,
+        radiance: Optional[Sequence[float]] = None,
+        strength: Optional[float] = None,
+        rotation: Optional[float] = None,
+    ) -> None:
+        """Changes the light from far away: an HDR ``map`` (``.hdr`` or ``.exr``; strength 1
+        and no turn unless given), a constant ``radiance`` (linear RGB; zero: none), or the
+        current map's ``strength`` and ``rotation`` (degrees about +y) alone, as the scene
+        file's ``[environment]`` and ``pathlight render --env`` give them."""
     @property
     def materials(self) -> list[str]:
         """The materials' names, in the scene's order."""
@@ -130,9 +142,15 @@ class Renderer:
         """Replaces the image with a state file's (of the same scene, camera and settings,
         from Python or the ``pathlight`` program) to go on from it; RenderError otherwise."""
 
-def load(source: Union[PathLike, Mapping[str, Any]], base_dir: Optional[PathLike] = None) -> Scene:
-    """A scene file (``.toml``), a glTF file (``.gltf``, ``.glb``), or a dict with the scene
-    file's keys (relative asset paths from ``base_dir``, the working folder by default)."""
+def load(
+    source: Union[PathLike, Mapping[str, Any]],
+    base_dir: Optional[PathLike] = None,
+    camera: Optional[int] = None,
+) -> Scene:
+    """A scene file (``.toml``), a glTF file (``.gltf``, ``.glb``: ``camera`` chooses one of
+    its cameras; without lights of its own it gets a grey sky, as ``pathlight render``
+    gives it), or a dict with the scene file's keys (relative asset paths from ``base_dir``,
+    the working folder by default)."""
 
 def default_scene() -> Scene:
     """The built-in default scene."""

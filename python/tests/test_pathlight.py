@@ -21,6 +21,8 @@ import pathlight
 
 REPO = Path(__file__).resolve().parents[2]
 CORNELL = REPO / "scenes" / "refs" / "cornell-spheres.toml"
+BOX = REPO / "crates" / "scene" / "tests" / "data" / "gltf" / "BoxTextured-glTF-Binary" / "BoxTextured.glb"
+SUNRISE = REPO / "assets" / "env" / "sunrise.exr"
 PATHLIGHT = os.environ.get("PATHLIGHT_BIN", str(REPO / "target" / "debug" / "pathlight"))
 
 
@@ -267,3 +269,30 @@ def test_the_example_sweep_runs(tmp_path):
                     "--spp", "1", "--size", "16", "--roughness", "0.1", "0.9", "--backend",
                     "cpu", "-o", str(out)], check=True, capture_output=True)
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_gltf_file_under_a_map_renders_as_the_cli_renders_it(tmp_path):
+    size = ["--width", 24, "--height", 16, "--spp", 2, "--backend", "cpu"]
+    scene = pathlight.load(BOX)
+    grey = pathlight.render(scene, spp=2, width=24, height=16, backend="cpu")
+    assert np.array_equal(grey, cli_render(tmp_path, BOX, *size))
+    # After a render (the scene prepared) as before one.
+    scene.set_environment(map=SUNRISE, strength=0.5, rotation=30)
+    lit = pathlight.render(scene, spp=2, width=24, height=16, backend="cpu")
+    expected = cli_render(tmp_path, BOX, *size, "--env", SUNRISE, "--env-strength", 0.5,
+                          "--env-rotation", 30)
+    assert np.array_equal(lit, expected)
+    fresh = pathlight.load(BOX)
+    fresh.set_environment(map=SUNRISE, strength=0.5, rotation=30)
+    assert np.array_equal(pathlight.render(fresh, spp=2, width=24, height=16, backend="cpu"),
+                          expected)
+    scene.set_environment(strength=2)
+    brighter = pathlight.render(scene, spp=2, width=24, height=16, backend="cpu")
+    assert np.array_equal(brighter, cli_render(tmp_path, BOX, *size, "--env", SUNRISE,
+                                               "--env-strength", 2, "--env-rotation", 30))
+    scene.set_environment(radiance=[0, 0, 0])
+    assert pathlight.render(scene, spp=1, width=24, height=16, backend="cpu").max() == 0
+    with pytest.raises(ValueError, match="need an environment map"):
+        scene.set_environment(rotation=10)
+    with pytest.raises(ValueError, match="camera chooses a camera of a glTF file"):
+        pathlight.load(CORNELL, camera=0)

@@ -137,26 +137,17 @@ fn apply_environment(scene: &mut Scene, args: &SceneArgs) -> anyhow::Result<()> 
     if let Some(rotation) = args.env_rotation {
         check_env_rotation("--env-rotation", rotation)?;
     }
-    if args.env.is_none() && args.env_strength.is_none() && args.env_rotation.is_none() {
-        return Ok(());
-    }
-    let (image, strength, rotation) = match (&args.env, &scene.environment) {
-        (Some(path), _) => (Arc::new(HdrImage::open(path)?), 1.0, 0.0),
-        (None, Environment::Map(map)) => (map.image.clone(), map.strength, map.rotation_deg),
-        (None, Environment::Constant(_)) => {
-            anyhow::ensure!(
-                args.env_strength.is_none() && args.env_rotation.is_none(),
-                "--env-strength and --env-rotation need an environment map (--env FILE, or \
-                 `map` in the scene's [environment])"
-            );
-            return Ok(());
-        }
+    let image = match &args.env {
+        Some(path) => Some(Arc::new(HdrImage::open(path)?)),
+        None => None,
     };
-    scene.environment = Environment::from_map(
-        image,
-        args.env_strength.unwrap_or(strength),
-        args.env_rotation.unwrap_or(rotation),
-    );
+    scene.environment = scene
+        .environment
+        .with_map(image, args.env_strength, args.env_rotation)
+        .context(
+            "--env-strength and --env-rotation need an environment map (--env FILE, or `map` \
+             in the scene's [environment])",
+        )?;
     Ok(())
 }
 

@@ -21,13 +21,14 @@ use crate::errors::{RenderError, SceneError, render_error};
 use crate::renderer::Renderer;
 use crate::scene::{Scene, SceneInput};
 
-/// Loads a scene: a scene file (`.toml`), a glTF file (`.gltf`, `.glb`) or, given a dict, the
-/// scene the dict's keys describe as a scene file's would (relative asset paths from
-/// `base_dir`, the working folder by default).
+/// Loads a scene: a scene file (`.toml`), a glTF file (`.gltf`, `.glb`; `camera` chooses
+/// one of its cameras, and without lights of its own it gets a grey sky, as `pathlight
+/// render` gives it) or, given a dict, the scene the dict's keys describe as a scene file's
+/// would (relative asset paths from `base_dir`, the working folder by default).
 #[pyfunction]
-#[pyo3(signature = (source, base_dir = None))]
-fn load(source: SceneInput, base_dir: Option<PathBuf>) -> PyResult<Scene> {
-    Scene::load(source, base_dir)
+#[pyo3(signature = (source, base_dir = None, camera = None))]
+fn load(source: SceneInput, base_dir: Option<PathBuf>, camera: Option<usize>) -> PyResult<Scene> {
+    Scene::load(source, base_dir, camera)
 }
 
 /// The built-in default scene.

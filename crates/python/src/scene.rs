@@ -2,12 +2,17 @@
 //! and the geometry prepared once for all of them.
 
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 use glam::Vec3;
-use pathlight_core::PreparedScene;
-use pathlight_scene::settings::{check_aperture, check_length, check_resolution};
-use pathlight_scene::{Camera, SceneSource, default_scene, gltf_scene, load_materials, load_scene};
+use pathlight_core::{EnvironmentData, PreparedScene};
+use pathlight_scene::settings::{
+    check_aperture, check_env_rotation, check_env_strength, check_length, check_resolution,
+};
+use pathlight_scene::{
+    Camera, Environment, HdrImage, SceneSource, default_scene, gltf_scene, load_materials,
+    load_scene,
+};
 use pyo3::exceptions::{PyKeyError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
@@ -70,8 +75,18 @@ impl Scene {
         }
     }
 
-    /// The scene `source` names (with `base_dir` for a dict's asset paths).
-    pub fn load(source: SceneInput, base_dir: Option<PathBuf>) -> PyResult<Self> {
+    /// The scene `source` names (with `base_dir` for a dict's asset paths; `camera`, a glTF
+    /// file's camera to look through).
+    pub fn load(
+        source: SceneInput,
+        base_dir: Option<PathBuf>,
+        camera: Option<usize>,
+    ) -> PyResult<Self> {
+        if camera.is_some() && !matches!(&source, SceneInput::Path(path) if is_gltf(path)) {
+            return Err(PyValueError::new_err(
+                "camera chooses a camera of a glTF file (.gltf, .glb)",
+            ));
+        }
         match source {
             SceneInput::Data(data) => {
                 let table = to_table(&data, "")?;
@@ -96,7 +111,7 @@ impl Scene {
                 }
                 if is_gltf(&path) {
                     return Ok(Self::new(
-                        gltf_scene(&path, None).map_err(scene_error)?,
+                        gltf_scene(&path, camera).map_err(scene_error)?,
                         None,
                     ));
                 }
@@ -233,6 +248,66 @@ impl Scene {
     #[pyo3(signature = (**keys))]
     fn set_camera(&mut self, keys: Option<&Bound<PyDict>>) -> PyResult<()> {
         self.scene.camera = changed_camera(&self.scene.camera, keys)?;
+        Ok(())
+    }
+
+    /// Changes the light from far away: an HDR `map` (a path: `.hdr` or `.exr`, strength 1,
+    /// no turn unless given), or a constant `radiance` (linear RGB; `[0, 0, 0]`: none), or the
+    /// current map's `strength` and `rotation` (degrees about +y) alone, as the scene file's
+    /// `[environment]` and `pathlight render --env` give them.
+    #[pyo3(signature = (*, map = None, radiance = None, strength = None, rotation = None))]
+    fn set_environment(
+        &mut self,
+        map: Option<PathBuf>,
+        radiance: Option<[f32; 3]>,
+        strength: Option<f32>,
+        rotation: Option<f32>,
+    ) -> PyResult<()> {
+        let value = |e: pathlight_scene::RangeError| PyValueError::new_err(e.to_string());
+        let environment = match radiance {
+            Some(radiance) => {
+                if map.is_some() || strength.is_some() || rotation.is_some() {
+                    return Err(PyValueError::new_err(
+                        "radiance is a constant environment: give it without map, strength and \
+                         rotation",
+                    ));
+                }
+                if !radiance.iter().all(|c| c.is_finite() && *c >= 0.0) {
+                    return Err(PyValueError::new_err(format!(
+                        "radiance = {radiance:?} must be finite and not negative"
+                    )));
+                }
+                Environment::Constant(Vec3::from(radiance))
+            }
+            None => {
+                if let Some(strength) = strength {
+                    check_env_strength("strength", strength).map_err(value)?;
+                }
+                if let Some(rotation) = rotation {
+                    check_env_rotation("rotation", rotation).map_err(value)?;
+                }
+                let image = match &map {
+                    Some(path) => Some(Arc::new(HdrImage::open(path).map_err(scene_error)?)),
+                    None => None,
+                };
+                self.scene
+                    .environment
+                    .with_map(image, strength, rotation)
+                    .ok_or_else(|| {
+                        PyValueError::new_err(
+                            "strength and rotation need an environment map: give map=PATH",
+                        )
+                    })?
+            }
+        };
+        self.scene.environment = environment;
+        if let Some(prepared) = self.prepared.get_mut() {
+            prepared.environment = Arc::new(match &self.scene.environment {
+                Environment::Map(map) => EnvironmentData::build(&map.image),
+                Environment::Constant(_) => EnvironmentData::none(),
+            });
+            prepared.shading = prepared.shading_of(&self.scene);
+        }
         Ok(())
     }
 

@@ -39,6 +39,29 @@ impl Environment {
             rotation_deg,
         })
     }
+
+    /// This environment with `map` in place of it (strength 1, no turn) where given, and the
+    /// map's strength and rotation set where given. `None` where a strength or rotation is
+    /// given for a constant environment and no map: there is no map to scale or turn.
+    pub fn with_map(
+        &self,
+        map: Option<Arc<HdrImage>>,
+        strength: Option<f32>,
+        rotation_deg: Option<f32>,
+    ) -> Option<Self> {
+        let (image, old_strength, old_rotation) = match (map, self) {
+            (Some(image), _) => (image, 1.0, 0.0),
+            (None, Self::Map(map)) => (map.image.clone(), map.strength, map.rotation_deg),
+            (None, Self::Constant(_)) => {
+                return (strength.is_none() && rotation_deg.is_none()).then(|| self.clone());
+            }
+        };
+        Some(Self::from_map(
+            image,
+            strength.unwrap_or(old_strength),
+            rotation_deg.unwrap_or(old_rotation),
+        ))
+    }
 }
 
 /// An equirectangular HDR map as the scene places it.
