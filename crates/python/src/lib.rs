@@ -53,10 +53,13 @@ fn render<'py>(
     backend: &str,
     max_depth: Option<u32>,
 ) -> PyResult<Bound<'py, PyArray3<f32>>> {
-    let mut renderer = Renderer::new(py, scene, backend, seed, width, height, max_depth, false, 0)?;
-    let spp = spp.unwrap_or(renderer.scene_spp());
-    renderer.render_to(py, spp)?;
-    renderer.image(py)
+    // No copy of the scene: the backend gets the prepared scene, camera and settings.
+    let (camera, settings) =
+        renderer::render_settings(scene, backend, seed, width, height, max_depth, false)?;
+    let prepared = scene.prepared(py)?;
+    let (mut backend, _) = renderer::open(py, &prepared, &camera, &settings, backend, 0)?;
+    renderer::render_to(py, &mut backend, spp.unwrap_or(settings.spp))?;
+    Ok(arrays::to_numpy(py, &backend.film().map_err(render_error)?))
 }
 
 /// Merges state files (shards of one render, or a render and its resumption) exactly and

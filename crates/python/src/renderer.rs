@@ -6,11 +6,12 @@ use std::sync::Mutex;
 
 use numpy::PyArray3;
 use pathlight_core::state::{Fingerprint, RenderState};
-use pathlight_core::{Accumulation, Film, Renderer as Backend};
+use pathlight_core::{Accumulation, Film, PreparedScene, Renderer as Backend};
 use pathlight_cpu::{CpuRenderer, InstructionSet};
 use pathlight_gpu::context::{AutoChoice, auto_choice, available_adapters};
 use pathlight_gpu::{Accel, GpuContext, GpuRenderer};
 use pathlight_scene::settings::{check_max_depth, check_resolution};
+use pathlight_scene::{Camera, RenderSettings};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -37,29 +38,15 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    /// The samples per pixel the scene asks for.
-    pub fn scene_spp(&self) -> u32 {
-        self.scene.scene.settings.spp
-    }
-
     fn backend(&mut self) -> &mut Box<dyn Backend + Send> {
         self.backend
             .get_mut()
             .unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
-    /// Renders until every pixel holds `spp` samples (from the first), the GIL released
-    /// while the backend works; a signal (Ctrl-C) raises its exception between steps of
-    /// a fraction of a second, the samples so far kept.
+    /// Renders until every pixel holds `spp` samples (see [`render_to`]).
     pub fn render_to(&mut self, py: Python, spp: u32) -> PyResult<()> {
-        let backend = self.backend();
-        while backend.samples_done() < spp {
-            let wanted = spp - backend.samples_done();
-            py.detach(|| backend.advance(wanted))
-                .map_err(render_error)?;
-            py.check_signals()?;
-        }
-        Ok(())
+        render_to(py, self.backend(), spp)
     }
 
     /// The image so far.
@@ -105,23 +92,13 @@ impl Renderer {
         aovs: bool,
         first_sample: u32,
     ) -> PyResult<Self> {
+        let (camera, settings) =
+            render_settings(scene, backend, seed, width, height, max_depth, aovs)?;
+        let prepared = scene.prepared(py)?;
+        let (renderer, kind) = open(py, &prepared, &camera, &settings, backend, first_sample)?;
         let mut scene = scene.clone();
-        let settings = &mut scene.scene.settings;
-        settings.seed = seed.unwrap_or(settings.seed);
-        settings.max_depth = max_depth.unwrap_or(settings.max_depth);
-        settings.aovs = aovs;
-        check_max_depth(settings.max_depth).map_err(|e| PyValueError::new_err(e.to_string()))?;
-        let camera = &mut scene.scene.camera;
-        camera.width = width.unwrap_or(camera.width);
-        camera.height = height.unwrap_or(camera.height);
-        check_resolution(camera.width, camera.height)
-            .map_err(|e| PyValueError::new_err(e.to_string()))?;
-        let (mut renderer, kind) = open(py, &scene, backend)?;
-        if first_sample > 0 {
-            let (width, height) = (scene.scene.camera.width, scene.scene.camera.height);
-            let empty = Accumulation::empty(width, height, first_sample, aovs);
-            renderer.resume(&empty).map_err(render_error)?;
-        }
+        scene.scene.camera = camera;
+        scene.scene.settings = settings;
         Ok(Self {
             scene,
             backend: Mutex::new(renderer),
@@ -248,43 +225,97 @@ impl Renderer {
     }
 }
 
-/// The backend `name` asks for, rendering `scene`, and its kind.
-fn open(
-    py: Python,
+/// The backends `open` opens.
+const BACKENDS: [&str; 3] = ["auto", "gpu", "cpu"];
+
+/// The error of a backend name not among [`BACKENDS`].
+fn unknown_backend(name: &str) -> PyErr {
+    PyValueError::new_err(format!(
+        "backend {name:?}: use \"auto\", \"gpu\" or \"cpu\""
+    ))
+}
+
+/// The camera and settings a render of `scene` runs with: the scene's, with the arguments
+/// given; refused, before anything is prepared, with a bad value or an unknown `backend`.
+pub fn render_settings(
     scene: &Scene,
-    name: &str,
-) -> PyResult<(Box<dyn Backend + Send>, &'static str)> {
-    if !matches!(name, "auto" | "gpu" | "cpu") {
-        return Err(PyValueError::new_err(format!(
-            "backend {name:?}: use \"auto\", \"gpu\" or \"cpu\""
-        )));
+    backend: &str,
+    seed: Option<u32>,
+    width: Option<u32>,
+    height: Option<u32>,
+    max_depth: Option<u32>,
+    aovs: bool,
+) -> PyResult<(Camera, RenderSettings)> {
+    if !BACKENDS.contains(&backend) {
+        return Err(unknown_backend(backend));
     }
-    let prepared = scene.prepared(py)?;
-    let (camera, settings) = (&scene.scene.camera, &scene.scene.settings);
+    let value = |e: pathlight_scene::RangeError| PyValueError::new_err(e.to_string());
+    let mut settings = scene.scene.settings;
+    settings.seed = seed.unwrap_or(settings.seed);
+    settings.max_depth = max_depth.unwrap_or(settings.max_depth);
+    settings.aovs = aovs;
+    check_max_depth(settings.max_depth).map_err(value)?;
+    let mut camera = scene.scene.camera.clone();
+    camera.width = width.unwrap_or(camera.width);
+    camera.height = height.unwrap_or(camera.height);
+    check_resolution(camera.width, camera.height).map_err(value)?;
+    Ok((camera, settings))
+}
+
+/// The backend `name` asks for ("auto", "gpu" or "cpu"), rendering `prepared` as `camera`
+/// and `settings` ask from sample `first_sample` on, and its kind.
+pub fn open(
+    py: Python,
+    prepared: &PreparedScene,
+    camera: &Camera,
+    settings: &RenderSettings,
+    name: &str,
+    first_sample: u32,
+) -> PyResult<(Box<dyn Backend + Send>, &'static str)> {
     let gpu = |context: GpuContext| -> PyResult<(Box<dyn Backend + Send>, &'static str)> {
         let renderer = py
-            .detach(|| GpuRenderer::new(&context, &prepared, camera, settings, Accel::Bvh))
+            .detach(|| GpuRenderer::new(&context, prepared, camera, settings, Accel::Bvh))
             .map_err(render_error)?;
         Ok((Box::new(renderer), "gpu"))
     };
-    match name {
+    let (mut renderer, kind) = match name {
         "cpu" => {
-            let mut renderer = CpuRenderer::new(&prepared, camera, settings);
+            let mut renderer = CpuRenderer::new(prepared, camera, settings);
             let level = InstructionSet::from_environment().map_err(render_error)?;
             renderer.set_instruction_set(level).map_err(render_error)?;
-            Ok((Box::new(renderer), "cpu"))
+            (Box::new(renderer) as Box<dyn Backend + Send>, "cpu")
         }
-        "gpu" => gpu(py.detach(|| GpuContext::new(None)).map_err(render_error)?),
+        "gpu" => gpu(py.detach(|| GpuContext::new(None)).map_err(render_error)?)?,
         "auto" => {
             let adapters = py.detach(available_adapters);
             let infos: Vec<_> = adapters.iter().map(|a| a.get_info()).collect();
             match auto_choice(&infos) {
                 AutoChoice::Gpu(i) => {
-                    gpu(GpuContext::from_adapter(&adapters[i]).map_err(render_error)?)
+                    gpu(GpuContext::from_adapter(&adapters[i]).map_err(render_error)?)?
                 }
-                AutoChoice::Cpu(_) => open(py, scene, "cpu"),
+                AutoChoice::Cpu(_) => {
+                    return open(py, prepared, camera, settings, "cpu", first_sample);
+                }
             }
         }
-        _ => unreachable!("the name was checked above"),
+        other => return Err(unknown_backend(other)),
+    };
+    if first_sample > 0 {
+        let empty = Accumulation::empty(camera.width, camera.height, first_sample, settings.aovs);
+        renderer.resume(&empty).map_err(render_error)?;
     }
+    Ok((renderer, kind))
+}
+
+/// Renders on `backend` until every pixel holds `spp` samples (from the first), the GIL
+/// released while it works; a signal (Ctrl-C) raises its exception between steps of a
+/// fraction of a second, the samples so far kept.
+pub fn render_to(py: Python, backend: &mut Box<dyn Backend + Send>, spp: u32) -> PyResult<()> {
+    while backend.samples_done() < spp {
+        let wanted = spp - backend.samples_done();
+        py.detach(|| backend.advance(wanted))
+            .map_err(render_error)?;
+        py.check_signals()?;
+    }
+    Ok(())
 }
