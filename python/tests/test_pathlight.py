@@ -200,6 +200,8 @@ def test_bad_scenes_and_values_raise_with_the_message(tmp_path):
         scene.set_camera(fov_y=0)
     with pytest.raises(TypeError, match='set_camera has no key "fov": it takes position'):
         scene.set_camera(fov=30)
+    with pytest.raises(ValueError, match="spp = 0"):
+        pathlight.render(scene, spp=0)
     with pytest.raises(ValueError, match='backend "tpu": use "auto", "gpu" or "cpu"'):
         pathlight.Renderer(scene, backend="tpu")
     # A refused change leaves the scene as it was.

@@ -15,6 +15,8 @@ use std::path::PathBuf;
 use numpy::{PyArray3, PyReadonlyArray3};
 use pathlight_core::state::{RenderState, merge as merge_states};
 use pathlight_denoise::{Aux, Denoiser, Mode};
+use pathlight_scene::settings::check_spp;
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::errors::{RenderError, SceneError, render_error};
@@ -56,9 +58,11 @@ fn render<'py>(
     // No copy of the scene: the backend gets the prepared scene, camera and settings.
     let (camera, settings) =
         renderer::render_settings(scene, backend, seed, width, height, max_depth, false)?;
+    let spp = spp.unwrap_or(settings.spp);
+    check_spp(spp).map_err(|e| PyValueError::new_err(e.to_string()))?;
     let prepared = scene.prepared(py)?;
     let (mut backend, _) = renderer::open(py, &prepared, &camera, &settings, backend, 0)?;
-    renderer::render_to(py, &mut backend, spp.unwrap_or(settings.spp))?;
+    renderer::render_to(py, &mut backend, spp)?;
     Ok(arrays::to_numpy(py, &backend.film().map_err(render_error)?))
 }
 
@@ -116,7 +120,7 @@ fn denoise<'py>(
         "final" => Mode::Final,
         "fast" => Mode::Fast,
         other => {
-            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            return Err(PyValueError::new_err(format!(
                 "mode {other:?}: use \"final\" or \"fast\""
             )));
         }
@@ -129,7 +133,7 @@ fn denoise<'py>(
         )),
         (None, None) => None,
         _ => {
-            return Err(pyo3::exceptions::PyValueError::new_err(
+            return Err(PyValueError::new_err(
                 "give albedo and normal together, or neither",
             ));
         }
