@@ -3,6 +3,8 @@
 import os
 from typing import Any, Mapping, Optional, Sequence, TypedDict, Union
 
+from typing_extensions import Unpack
+
 import numpy as np
 import numpy.typing as npt
 
@@ -30,6 +32,18 @@ class Camera(TypedDict):
     aperture_radius: float
     focus_distance: float
 
+class CameraKeys(TypedDict, total=False):
+    """What ``set_camera`` changes (``None``: unchanged)."""
+
+    position: Optional[Sequence[float]]
+    look_at: Optional[Sequence[float]]
+    up: Optional[Sequence[float]]
+    fov_y: Optional[float]
+    width: Optional[int]
+    height: Optional[int]
+    aperture_radius: Optional[float]
+    focus_distance: Optional[float]
+
 class Scene:
     """A scene from a scene file, a glTF file or Python data (``load``). Its camera and (for
     a scene file's or data's scene) its materials change between renders; its geometry is
@@ -38,18 +52,7 @@ class Scene:
     @property
     def camera(self) -> Camera:
         """The camera (a copy: change it with ``set_camera``)."""
-    def set_camera(
-        self,
-        *,
-        position: Optional[Sequence[float]] = None,
-        look_at: Optional[Sequence[float]] = None,
-        up: Optional[Sequence[float]] = None,
-        fov_y: Optional[float] = None,
-        width: Optional[int] = None,
-        height: Optional[int] = None,
-        aperture_radius: Optional[float] = None,
-        focus_distance: Optional[float] = None,
-    ) -> None:
+    def set_camera(self, **keys: Unpack[CameraKeys]) -> None:
         """Moves, turns or resizes the camera; keys left out keep their values. A focus
         distance that was the distance to ``look_at`` follows a moved camera or target.
         Raises ValueError for a camera the scene file would refuse."""
@@ -118,18 +121,7 @@ class Renderer:
     @property
     def camera(self) -> Camera:
         """The renderer's camera."""
-    def set_camera(
-        self,
-        *,
-        position: Optional[Sequence[float]] = None,
-        look_at: Optional[Sequence[float]] = None,
-        up: Optional[Sequence[float]] = None,
-        fov_y: Optional[float] = None,
-        width: Optional[int] = None,
-        height: Optional[int] = None,
-        aperture_radius: Optional[float] = None,
-        focus_distance: Optional[float] = None,
-    ) -> None:
+    def set_camera(self, **keys: Unpack[CameraKeys]) -> None:
         """As ``Scene.set_camera``, and the image starts again."""
     def set_material(self, name: str, **keys: Any) -> None:
         """As ``Scene.set_material``, and the image starts again."""

@@ -8,6 +8,7 @@ use glam::Vec3;
 use pathlight_core::{EnvironmentData, PreparedScene};
 use pathlight_scene::settings::{
     check_aperture, check_env_rotation, check_env_strength, check_length, check_resolution,
+    check_view,
 };
 use pathlight_scene::{
     Camera, Environment, HdrImage, SceneSource, default_scene, gltf_scene, load_materials,
@@ -422,20 +423,8 @@ pub fn changed_camera(camera: &Camera, keys: Option<&Bound<PyDict>>) -> PyResult
     let position = point("position", camera.position)?;
     let look_at = point("look_at", camera.look_at)?;
     let up = point("up", camera.up)?;
-    if position.distance(look_at) <= 0.0 {
-        return Err(PyValueError::new_err("look_at equals position"));
-    }
-    if up.cross(look_at - position).length_squared() <= 0.0 {
-        return Err(PyValueError::new_err(
-            "up is parallel to the view direction",
-        ));
-    }
     let fov_y_deg = number("fov_y")?.unwrap_or(camera.fov_y_deg);
-    if !(fov_y_deg > 0.0 && fov_y_deg < 180.0) {
-        return Err(PyValueError::new_err(format!(
-            "fov_y = {fov_y_deg} must lie strictly between 0 and 180 degrees"
-        )));
-    }
+    check_view("", position, look_at, up, fov_y_deg).map_err(value)?;
     let width = size("width")?.unwrap_or(camera.width);
     let height = size("height")?.unwrap_or(camera.height);
     check_resolution(width, height).map_err(value)?;

@@ -1,6 +1,8 @@
 //! Sampling settings of a render and the limits every input is checked against, by the
 //! scene loader and the command line alike (each names the key or option it checked).
 
+use glam::Vec3;
+
 use crate::error::RangeError;
 
 /// Largest magnitude of a coordinate or a length in a scene: far below f32's range, so that
@@ -62,6 +64,34 @@ pub fn check_spp(spp: u32) -> Result<(), RangeError> {
             "spp = {spp} is out of range 1..={MAX_SPP}"
         )))
     }
+}
+
+/// Checks a camera's view: a `look_at` apart from its `position`, an `up` not along the view
+/// and a vertical field of view `fov_y` (degrees) strictly between 0 and 180. `prefix` goes
+/// before the keys' names in the message (`camera.` in a scene file).
+pub fn check_view(
+    prefix: &str,
+    position: Vec3,
+    look_at: Vec3,
+    up: Vec3,
+    fov_y: f32,
+) -> Result<(), RangeError> {
+    if position.distance(look_at) <= 0.0 {
+        return Err(RangeError(format!(
+            "{prefix}look_at equals {prefix}position"
+        )));
+    }
+    if up.cross(look_at - position).length_squared() <= 0.0 {
+        return Err(RangeError(format!(
+            "{prefix}up is parallel to the view direction"
+        )));
+    }
+    if !(fov_y > 0.0 && fov_y < 180.0) {
+        return Err(RangeError(format!(
+            "{prefix}fov_y = {fov_y} must lie strictly between 0 and 180 degrees"
+        )));
+    }
+    Ok(())
 }
 
 /// Checks a path length against [`MAX_DEPTH`].

@@ -592,3 +592,36 @@ fn materials_load_alone_as_the_whole_scene_loads_them() {
     assert_eq!(message, load_scene(&bad).unwrap_err().to_string());
     assert!(message.contains("materials.floor.ior"), "{message}");
 }
+
+#[test]
+fn a_camera_that_cannot_see_is_refused_naming_the_key() {
+    let camera = |position: &str, up: &str, fov: &str| {
+        let text = format!(
+            "[camera]\nposition = {position}\nlook_at = [0, 0, 0]\nup = {up}\nfov_y = {fov}\n\
+             resolution = [8, 8]\n"
+        );
+        load_scene(&SceneSource {
+            name: "test.toml".into(),
+            text: &text,
+            base_dir: data(),
+            embedded: &[],
+        })
+        .expect_err("this camera must be refused")
+        .to_string()
+    };
+    let at_origin = camera("[0, 0, 0]", "[0, 1, 0]", "40");
+    assert!(
+        at_origin.contains("test.toml:1: camera.look_at equals camera.position"),
+        "{at_origin}"
+    );
+    let up_along = camera("[0, 3, 0]", "[0, 1, 0]", "40");
+    assert!(
+        up_along.contains("camera.up is parallel to the view direction"),
+        "{up_along}"
+    );
+    let flat = camera("[0, 0, 3]", "[0, 1, 0]", "180");
+    assert!(
+        flat.contains("camera.fov_y = 180 must lie strictly between 0 and 180"),
+        "{flat}"
+    );
+}

@@ -19,7 +19,7 @@ use crate::error::RangeError;
 use crate::error::SceneError;
 use crate::settings::{
     MAX_COORDINATE, check_aperture, check_env_rotation, check_env_strength, check_length,
-    check_max_depth, check_resolution, check_spp,
+    check_max_depth, check_resolution, check_spp, check_view,
 };
 use crate::texture::srgb_to_linear;
 use crate::{Camera, Environment, HdrImage, Material, RenderSettings, Sampler, Scene, Texture};
@@ -153,21 +153,8 @@ impl Builder<'_, '_> {
         let position = self.point(span.clone(), "camera.position", c.position)?;
         let look_at = self.point(span.clone(), "camera.look_at", c.look_at)?;
         let up = self.point(span.clone(), "camera.up", c.up)?;
-        if position.distance(look_at) <= 0.0 {
-            return Err(self.invalid(span, "camera.look_at equals camera.position".into()));
-        }
-        if up.cross(look_at - position).length_squared() <= 0.0 {
-            return Err(self.invalid(span, "camera.up is parallel to the view direction".into()));
-        }
-        if !(c.fov_y > 0.0 && c.fov_y < 180.0) {
-            return Err(self.invalid(
-                span,
-                format!(
-                    "camera.fov_y = {} must lie strictly between 0 and 180 degrees",
-                    c.fov_y
-                ),
-            ));
-        }
+        check_view("camera.", position, look_at, up, c.fov_y)
+            .map_err(|e| self.invalid(span.clone(), e.to_string()))?;
         let [width, height] = c.resolution;
         check_resolution(width, height).map_err(|e| self.invalid(span.clone(), e.to_string()))?;
         let range = |result: Result<f32, RangeError>| {
