@@ -124,20 +124,25 @@ pub(crate) fn empty_tree() -> Vec<GpuWideNode> {
     }]
 }
 
-/// The 4-wide form of `tree`, root at 0, in pre-order. Each wide node takes the binary
-/// node's children and keeps opening its largest inner child (by surface area) until it has
-/// four. A leaf child holding a whole shape (`is_shape` of its first primitive slot ..) is
-/// marked [`SHAPE_LEAF`]; an unused child has an inverted box.
-pub(crate) fn collapse(tree: &BinaryTree, is_shape: &[bool]) -> Vec<GpuWideNode> {
-    let mut out = Vec::new();
-    collapse_node(&tree.nodes, is_shape, 0, &mut out);
-    out
+/// Appends the 4-wide form of `tree` to `out` in pre-order and returns its root's index.
+/// Each wide node takes the binary node's children and keeps opening its largest inner child
+/// (by surface area) until it has four. A leaf's primitives are the tree's leaf slots plus
+/// `primitive_base`; a leaf child holding a whole shape (`is_shape` of its first primitive
+/// slot ..) is marked [`SHAPE_LEAF`]; an unused child has an inverted box.
+pub(crate) fn collapse(
+    tree: &BinaryTree,
+    is_shape: &[bool],
+    primitive_base: u32,
+    out: &mut Vec<GpuWideNode>,
+) -> u32 {
+    collapse_node(&tree.nodes, is_shape, primitive_base, 0, out)
 }
 
 /// Appends the 4-wide form of the binary subtree at `root`; returns its node index.
 fn collapse_node(
     nodes: &[Bvh2Node],
     is_shape: &[bool],
+    primitive_base: u32,
     root: u32,
     out: &mut Vec<GpuWideNode>,
 ) -> u32 {
@@ -170,9 +175,9 @@ fn collapse_node(
             let slots = c.first_index as usize..(c.first_index + c.prim_count) as usize;
             let shape = is_shape[slots].iter().any(|&s| s);
             let mark = if shape { SHAPE_LEAF } else { 0 };
-            (c.first_index, c.prim_count | mark)
+            (primitive_base + c.first_index, c.prim_count | mark)
         } else {
-            (collapse_node(nodes, is_shape, child, out), 0)
+            (collapse_node(nodes, is_shape, primitive_base, child, out), 0)
         };
         let n = &mut out[index as usize];
         let (lo, hi) = (c.aabb.min, c.aabb.max);
@@ -209,12 +214,13 @@ pub fn parents(nodes: &[GpuWideNode]) -> Vec<u32> {
 /// The root's entry in [`parents`].
 pub const NO_PARENT: u32 = u32::MAX;
 
-/// Most entries the traversal stack of WGSL `trace_scene` needs in the tree `nodes` (in
-/// pre-order) to finish every walk with it. At each node the walk tests the entered leaves
+/// Most entries the traversal stacks of WGSL `trace_scene` and `trace_mesh` need in the
+/// trees at `roots` of `nodes` (in pre-order: the top level's at 0, each shared mesh's
+/// after it) to finish every walk with them. At each node the walk tests the entered leaves
 /// that hold shapes at once and pushes the other entered children but the nearest, and the
 /// stack holds only the pending entries of the current node and its ancestors (an entry is
 /// popped before its node is visited). At least 1: WGSL has no empty arrays.
-pub fn stack_bound(nodes: &[GpuWideNode]) -> u32 {
+pub fn stack_bound(nodes: &[GpuWideNode], roots: &[u32]) -> u32 {
     // Most entries pushed along one path down from each node; children come after their
     // parent in pre-order, so a reverse sweep sees them first (no recursion on deep trees).
     let mut below = vec![0u32; nodes.len()];
@@ -231,5 +237,10 @@ pub fn stack_bound(nodes: &[GpuWideNode]) -> u32 {
             .unwrap_or(0);
         below[index] = pushed.saturating_sub(1) + deepest;
     }
-    below[0].max(1)
+    roots
+        .iter()
+        .map(|&root| below[root as usize])
+        .max()
+        .unwrap_or(0)
+        .max(1)
 }

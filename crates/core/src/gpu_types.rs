@@ -31,13 +31,20 @@ pub const FLAG_CAPS: u32 = 2;
 /// [`GpuObject::flags`] bit: a mesh whose material has alpha holes (masked or blended), so
 /// that a ray tests the texel where it hits before it stops.
 pub const FLAG_ALPHA: u32 = 4;
+/// [`GpuObject::flags`] bit: a mesh placed as an instance of a shared mesh, whose triangles
+/// and tree are in its own space; [`GpuObject::instance`] names its transforms.
+pub const FLAG_INSTANCE: u32 = 8;
+/// [`GpuObject::flags`] bit: an instance whose placement mirrors (negative determinant), so
+/// that its triangles' front side and bitangents turn over.
+pub const FLAG_MIRRORED: u32 = 16;
 
 /// One object of the scene, in the scene's order. WGSL: `Object`.
 ///
 /// Geometry by kind: quad `a` = origin, `b` = edge_u, `c` = edge_v; sphere `a.xyz` = centre,
 /// `a.w` = radius, `b.x` = texture rotation (radians); cylinder `a.xyz` = p0, `a.w` = radius,
 /// `b.xyz` = p1; mesh: its triangles `first_triangle ..` in the vertex buffer, and the box
-/// around them from `a.xyz` to `b.xyz` (for the seed's bounding-volume scheme).
+/// around them in the world from `a.xyz` to `b.xyz` (for the seed's bounding-volume scheme);
+/// an instance ([`FLAG_INSTANCE`]) shares its triangles with the other placements of its mesh.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct GpuObject {
@@ -60,8 +67,10 @@ pub struct GpuObject {
     pub first_triangle: u32,
     /// Mesh only: number of its triangles (`first_triangle ..` in the vertex buffer).
     pub triangle_count: u32,
+    /// An instance ([`FLAG_INSTANCE`]): its entry in the instance buffer.
+    pub instance: u32,
     /// Padding to 16 bytes.
-    pub pad: [u32; 2],
+    pub pad: u32,
 }
 const _: () = assert!(size_of::<GpuObject>() == 80);
 
@@ -169,10 +178,26 @@ pub struct GpuPrimitive {
     pub triangle: u32,
     /// Triangle: corner 2.
     pub v2: [f32; 3],
-    /// Padding.
-    pub pad: u32,
+    /// An instance ([`INSTANCE`]): the root node of its mesh's tree.
+    pub root: u32,
 }
 const _: () = assert!(size_of::<GpuPrimitive>() == 48);
+
+/// [`GpuPrimitive::triangle`] of a placed instance: a ray that enters its box walks its
+/// mesh's tree from [`GpuPrimitive::root`] in the mesh's space.
+pub const INSTANCE: u32 = u32::MAX - 1;
+
+/// The placement of an instance ([`FLAG_INSTANCE`]): rows of its affine transforms, each
+/// `[x, y, z, translation]`. WGSL: `Instance`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuInstance {
+    /// World to the mesh's space (rays enter by it; normals leave by its transpose).
+    pub to_object: [[f32; 4]; 3],
+    /// The mesh's space to the world (light samples and tangents leave by it).
+    pub to_world: [[f32; 4]; 3],
+}
+const _: () = assert!(size_of::<GpuInstance>() == 96);
 
 /// [`GpuMaterial::flags`] bit: texels with alpha below `alpha_cutoff` are holes.
 pub const MATERIAL_MASK: u32 = 1;

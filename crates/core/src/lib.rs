@@ -10,6 +10,7 @@ pub mod environment;
 pub mod error;
 pub mod film;
 pub mod geometry;
+pub mod instance;
 pub mod gpu_types;
 pub mod light_table;
 pub mod materials;

@@ -10,8 +10,9 @@ use glam::Vec3;
 use pathlight_scene::{Light, LightKind};
 
 use crate::geometry::Geometry;
+use crate::instance::world_triangle;
 use crate::gpu_types::{
-    FLAG_CAPS, GpuLight, GpuObject, GpuVertex, KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE,
+    FLAG_CAPS, GpuInstance, GpuLight, GpuObject, GpuVertex, KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE,
     LIGHT_AREA, LIGHT_POINT, LIGHT_SUN, NO_LIGHT,
 };
 
@@ -22,10 +23,16 @@ pub fn luminance(rgb: Vec3) -> f32 {
 }
 
 /// Surface area of light-table entry `(object, primitive)`: the whole shape, or triangle
-/// `primitive` (in `vertices`) of a mesh. The CPU backend's twin of WGSL `emitter_area`
-/// calls it, inlined into its row renderer (a call would make it save its vector registers).
+/// `primitive` (in `vertices`) of a mesh (placed, for an instance, by its transform in
+/// `instances`). The CPU backend's twin of WGSL `emitter_area` calls it, inlined into its
+/// row renderer (a call would make it save its vector registers).
 #[inline(always)]
-pub fn emitter_area(object: &GpuObject, vertices: &[GpuVertex], primitive: u32) -> f32 {
+pub fn emitter_area(
+    object: &GpuObject,
+    vertices: &[GpuVertex],
+    instances: &[GpuInstance],
+    primitive: u32,
+) -> f32 {
     let [a, b, c] = [object.a, object.b, object.c].map(|v| Vec3::from_slice(&v));
     match object.kind {
         KIND_QUAD => b.cross(c).length(),
@@ -40,8 +47,7 @@ pub fn emitter_area(object: &GpuObject, vertices: &[GpuVertex], primitive: u32) 
             std::f32::consts::TAU * r * (b - a).length() + caps * std::f32::consts::PI * r * r
         }
         _ => {
-            let i = 3 * primitive as usize;
-            let [v0, v1, v2] = [0, 1, 2].map(|k| Vec3::from(vertices[i + k].position));
+            let [v0, v1, v2] = world_triangle(object, vertices, instances, primitive);
             0.5 * (v1 - v0).cross(v2 - v0).length()
         }
     }
@@ -87,7 +93,7 @@ pub fn build(
         };
         object.light = table.len() as u32;
         for primitive in primitives {
-            powers.push(emitter_area(object, &geometry.vertices, primitive) * luminance);
+            powers.push(emitter_area(object, &geometry.vertices, &geometry.instances, primitive) * luminance);
             table.push(GpuLight {
                 kind: LIGHT_AREA,
                 index: i as u32,

@@ -90,6 +90,7 @@ impl Fingerprint {
             bytemuck::cast_slice(&geometry.primitives),
             bytemuck::cast_slice(&geometry.vertices),
             bytemuck::cast_slice(&geometry.shapes),
+            bytemuck::cast_slice(&geometry.instances),
             bytemuck::cast_slice(&textures.texels),
             bytemuck::cast_slice(&shading.objects),
             bytemuck::cast_slice(&shading.materials),

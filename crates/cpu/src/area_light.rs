@@ -10,6 +10,7 @@ use glam::{Vec2, Vec3A};
 use pathlight_core::gpu_types::{
     FLAG_CAPS, GpuObject, KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE,
 };
+use pathlight_core::instance::world_triangle;
 use pathlight_core::light_table;
 
 use crate::cpu_scene::CpuScene;
@@ -26,7 +27,7 @@ fn emitter_area(scene: &CpuScene, object: u32, o: &GpuObject, primitive: u32) ->
     if o.kind == KIND_QUAD {
         scene.quad_area(object)
     } else {
-        light_table::emitter_area(o, scene.vertices, primitive)
+        light_table::emitter_area(o, scene.vertices, scene.instances, primitive)
     }
 }
 
@@ -141,7 +142,7 @@ fn sample_shape(
             }
         }
         _ => {
-            let [v0, v1, v2] = scene.triangle(primitive).map(Vec3A::from);
+            let [v0, v1, v2] = world_triangle(o, scene.vertices, scene.instances, primitive);
             let su = u.x.sqrt();
             let (b1, b2) = (1.0 - su, u.y * su);
             let cross = (v1 - v0).cross(v2 - v0);

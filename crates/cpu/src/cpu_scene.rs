@@ -5,7 +5,7 @@
 use glam::{Vec3, Vec3A};
 use pathlight_core::PreparedScene;
 use pathlight_core::gpu_types::{
-    GpuLight, GpuMaterial, GpuObject, GpuPrimitive, GpuTextureSlot, GpuVertex, GpuWideNode,
+    GpuInstance, GpuLight, GpuMaterial, GpuObject, GpuPrimitive, GpuTextureSlot, GpuVertex, GpuWideNode,
     KIND_QUAD,
 };
 
@@ -20,6 +20,8 @@ pub struct CpuScene<'a> {
     pub primitives: &'a [GpuPrimitive],
     /// Triangle corners (WGSL `vertices`).
     pub vertices: &'a [GpuVertex],
+    /// The placements of instances (WGSL `instances`).
+    pub instances: &'a [GpuInstance],
     /// Objects with their materials (WGSL `objects`).
     pub objects: &'a [GpuObject],
     /// Materials' common parts (WGSL `materials`).
@@ -60,6 +62,7 @@ impl<'a> CpuScene<'a> {
             nodes: &scene.geometry.nodes,
             primitives: &scene.geometry.primitives,
             vertices: &scene.geometry.vertices,
+            instances: &scene.geometry.instances,
             objects,
             materials: &scene.shading.materials,
             param_blocks: &scene.shading.param_blocks,

@@ -15,10 +15,11 @@ use std::ops::Range;
 use glam::Vec3;
 
 use pathlight_core::gpu_types::{
-    FLAG_ALPHA, FLAG_CAPS, GpuWideNode, KIND_QUAD, KIND_SPHERE, NO_TRIANGLE, SHAPE_LEAF,
+    FLAG_ALPHA, FLAG_CAPS, GpuPrimitive, GpuWideNode, INSTANCE, KIND_QUAD, KIND_SPHERE,
+    NO_TRIANGLE, SHAPE_LEAF,
 };
 
-use crate::bvh::{Entry, Hit, RayLanes, Walk};
+use crate::bvh::{Entry, Hit, RayLanes, TOP_LEVEL, Walk};
 use crate::cpu_scene::CpuScene;
 use crate::intersect::{
     MISS, ROBUST_FAR, Ray, ShearedRay, intersect_cylinder, intersect_quad, intersect_sphere,
@@ -363,7 +364,7 @@ impl PacketWalk<'_> {
                 let count = n.count[child] & !SHAPE_LEAF;
                 if count > 0 && child_lanes != 0 {
                     let first = n.first[child];
-                    self.primitives(first..first + count, child_lanes, hits);
+                    self.primitives(stacks, first..first + count, child_lanes, hits);
                 }
             }
             for &(_, child_lanes, child) in order[..entered].iter().rev() {
@@ -416,13 +417,24 @@ impl PacketWalk<'_> {
         (near[0], entered)
     }
 
-    /// Tests the primitives `range` with the rays `lanes`.
+    /// Tests the primitives `range` with the rays `lanes` (an instance with each ray alone,
+    /// on the single-ray stack).
     #[inline(always)]
-    fn primitives(&self, range: Range<u32>, lanes: Lanes, hits: &mut PacketHits) {
+    fn primitives(
+        &self,
+        stacks: &mut Stacks,
+        range: Range<u32>,
+        lanes: Lanes,
+        hits: &mut PacketHits,
+    ) {
         let rays = self.rays;
         for i in range {
             let lanes = lanes & hits.searching;
             let p = &self.scene.primitives[i as usize];
+            if p.triangle == INSTANCE {
+                self.instance(stacks, p, lanes, hits);
+                continue;
+            }
             if p.triangle != NO_TRIANGLE {
                 let corners = [p.v0, p.v1, p.v2].map(Vec3::from);
                 if self.scene.objects[p.object as usize].flags & FLAG_ALPHA != 0 {
@@ -467,21 +479,49 @@ impl PacketWalk<'_> {
     /// Ray `lane` walks the subtree at `node` alone.
     #[inline(always)]
     fn alone(&self, stacks: &mut Stacks, lane: usize, node: u32, hits: &mut PacketHits) {
-        let ray = self.rays.ray(lane);
-        let lanes = RayLanes::new(&ray);
-        let walk = Walk {
-            scene: self.scene,
-            ray: &ray,
-            sheared: self.rays.sheared(lane),
-            lanes: &lanes,
-            any_hit: self.any_hit,
-        };
-        let mut hit = hits.get(lane);
-        stacks.single.clear();
-        walk.tree(stacks.single, node, &mut hit);
-        hits.set(lane, hit);
-        if self.any_hit && hit.object != u32::MAX {
-            hits.searching &= !(1 << lane);
+        self.each_alone(stacks, 1 << lane, hits, |walk, stack, hit| {
+            walk.tree(stack, node, hit)
+        });
+    }
+
+    /// The rays `lanes` walk the tree of the instance `p` places, one by one.
+    #[inline(never)]
+    fn instance(&self, stacks: &mut Stacks, p: &GpuPrimitive, lanes: Lanes, hits: &mut PacketHits) {
+        self.each_alone(stacks, lanes, hits, |walk, stack, hit| {
+            walk.instance(stack, p, hit)
+        });
+    }
+
+    /// Each ray of `lanes` in turn, with its current hit, given to `walk` as a single-ray
+    /// walk of the top level (the single-ray stack emptied first).
+    #[inline(always)]
+    fn each_alone(
+        &self,
+        stacks: &mut Stacks,
+        mut lanes: Lanes,
+        hits: &mut PacketHits,
+        walk: impl Fn(&Walk, &mut Vec<Entry>, &mut Hit),
+    ) {
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            let ray = self.rays.ray(lane);
+            let ray_lanes = RayLanes::new(&ray);
+            let single = Walk {
+                scene: self.scene,
+                ray: &ray,
+                sheared: self.rays.sheared(lane),
+                lanes: &ray_lanes,
+                any_hit: self.any_hit,
+                object: TOP_LEVEL,
+            };
+            let mut hit = hits.get(lane);
+            stacks.single.clear();
+            walk(&single, stacks.single, &mut hit);
+            hits.set(lane, hit);
+            if self.any_hit && hit.object != u32::MAX {
+                hits.searching &= !(1 << lane);
+            }
         }
     }
 }
@@ -497,7 +537,10 @@ mod tests {
     use rand::rngs::StdRng;
 
     use super::{Lanes, PACKET, RayPacket};
-    use crate::bvh::tests::{assert_like_brute_force, prepare, random_ray, ray_into_scene};
+    use crate::bvh::tests::{
+        assert_like_brute_force, instanced_objects, prepare, random_ray, ray_into_scene,
+    };
+    use pathlight_scene::testing::flattened;
     use crate::cpu_scene::CpuScene;
     use crate::intersect::Ray;
     use crate::tracer::Tracer;
@@ -505,8 +548,9 @@ mod tests {
     /// Each ray traced in a packet with others of `rays`, at a lane that depends on the ray,
     /// gets brute force's answer. Every other packet holds the ray alone (it walks alone from
     /// the root), the others most lanes; a bit beyond the packet's lanes is set too and must
-    /// be ignored.
-    fn assert_packets(scene: &CpuScene, rays: &[Ray]) -> usize {
+    /// be ignored. Brute force looks in `truth`: `scene` itself, or the same scene with its
+    /// instances flattened.
+    fn assert_packets(scene: &CpuScene, truth: &CpuScene, rays: &[Ray]) -> usize {
         let tracer = RefCell::new(Tracer::new(scene));
         let packet_of = |ray: &Ray, t_max: f32| {
             let start = ray.origin.x.to_bits() as usize % rays.len();
@@ -531,8 +575,10 @@ mod tests {
             }
             (packet, lane)
         };
+        let tolerance = if std::ptr::eq(scene, truth) { 1e-5 } else { 1e-4 };
         assert_like_brute_force(
-            scene,
+            truth,
+            tolerance,
             rays,
             "packet",
             &mut |r, t| {
@@ -555,7 +601,7 @@ mod tests {
             let rays: Vec<Ray> = (0..2000)
                 .map(|_| ray_into_scene(&mut rng, &scene))
                 .collect();
-            assert!(assert_packets(&scene, &rays) > 20);
+            assert!(assert_packets(&scene, &scene, &rays) > 20);
         }
         let prepared = prepare(vec![object(
             "big",
@@ -563,6 +609,18 @@ mod tests {
         )]);
         let scene = CpuScene::new(&prepared);
         let rays: Vec<Ray> = (0..300).map(|_| random_ray(&mut rng, 1.0)).collect();
-        assert!(assert_packets(&scene, &rays) > 50);
+        assert!(assert_packets(&scene, &scene, &rays) > 50);
+    }
+
+    #[test]
+    fn packets_through_instances_find_what_the_flattened_scene_holds() {
+        let mut rng = StdRng::seed_from_u64(23);
+        let objects = instanced_objects(&mut rng);
+        let (prepared, flat) = (prepare(objects.clone()), prepare(flattened(&objects)));
+        let (scene, truth) = (CpuScene::new(&prepared), CpuScene::new(&flat));
+        let rays: Vec<Ray> = (0..2000)
+            .map(|_| ray_into_scene(&mut rng, &scene))
+            .collect();
+        assert!(assert_packets(&scene, &truth, &rays) > 200);
     }
 }

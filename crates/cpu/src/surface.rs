@@ -5,7 +5,7 @@ use std::f32::consts::{PI, TAU};
 
 use glam::{Vec2, Vec3A};
 use pathlight_core::gpu_types::{
-    FLAG_CAPS, FLAG_FLAT, GpuMaterial, KIND_CYLINDER, KIND_QUAD, KIND_SPHERE, TEXTURE_COAT_NORMAL,
+    FLAG_CAPS, FLAG_FLAT, FLAG_INSTANCE, FLAG_MIRRORED, GpuMaterial, KIND_CYLINDER, KIND_QUAD, KIND_SPHERE, TEXTURE_COAT_NORMAL,
     TEXTURE_NORMAL,
 };
 use pathlight_core::octahedral::{self, tangent_sign};
@@ -151,10 +151,13 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
             let [v0, v1, v2] = [0, 1, 2].map(|k| scene.vertices[i + k]);
             let b0 = 1.0 - hit.b1 - hit.b2;
             let [p0, p1, p2] = [v0, v1, v2].map(|v| Vec3A::from(v.position));
-            s.ng = (p1 - p0).cross(p2 - p0).normalize();
+            let instance = (o.flags & FLAG_INSTANCE != 0).then(|| &scene.instances[o.instance as usize]);
+            let ng = (p1 - p0).cross(p2 - p0);
+            s.ng = instance.map_or(ng, |i| i.to_world_normal(ng)).normalize();
             let decode = |code: u32| Vec3A::from(octahedral::decode(code));
             let n =
                 b0 * decode(v0.normal) + hit.b1 * decode(v1.normal) + hit.b2 * decode(v2.normal);
+            let n = instance.map_or(n, |i| i.to_world_normal(n));
             s.uv = b0 * Vec2::from(v0.uv) + hit.b1 * Vec2::from(v1.uv) + hit.b2 * Vec2::from(v2.uv);
             s.color = triangle_color(scene, hit.primitive, hit.b1, hit.b2)
                 .truncate()
@@ -171,11 +174,15 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
             let tangent = if m.texture_mask & ((1 << TEXTURE_NORMAL) | (1 << TEXTURE_COAT_NORMAL))
                 != 0
             {
-                b0 * decode(v0.tangent) + hit.b1 * decode(v1.tangent) + hit.b2 * decode(v2.tangent)
+                let t = b0 * decode(v0.tangent)
+                    + hit.b1 * decode(v1.tangent)
+                    + hit.b2 * decode(v2.tangent);
+                instance.map_or(t, |i| i.to_world_vector(t))
             } else {
                 Vec3A::ZERO
             };
-            let sign = tangent_sign(v0.tangent);
+            let mirrored = o.flags & FLAG_MIRRORED != 0;
+            let sign = tangent_sign(v0.tangent) * if mirrored { -1.0 } else { 1.0 };
             if has_texture(m, TEXTURE_NORMAL) {
                 s.ns = normal_mapped(
                     scene,

@@ -6,6 +6,7 @@
 
 #import scene
 #import intersect
+#import instance
 #import sampling
 #import textures
 #import material
@@ -29,9 +30,8 @@ fn emitter_area(o: Object, primitive: u32) -> f32 {
             return TAU * r * length(o.b.xyz - o.a.xyz) + caps;
         }
         default: {
-            let i = 3u * primitive;
-            let v0 = vertices[i].position;
-            return 0.5 * length(cross(vertices[i + 1u].position - v0, vertices[i + 2u].position - v0));
+            let v = world_triangle(o, primitive);
+            return 0.5 * length(cross(v[1] - v[0], v[2] - v[0]));
         }
     }
 }
@@ -125,10 +125,10 @@ fn sample_shape(o: Object, primitive: u32, p: vec3f, u: vec2f, u_part: f32) -> S
             return ShapeSample(center + frame[0] * d.x + frame[1] * d.y, select(-axis, axis, top), 1.0 / area, vec2f(0.0));
         }
         default: {
-            let i = 3u * primitive;
-            let v0 = vertices[i].position;
-            let v1 = vertices[i + 1u].position;
-            let v2 = vertices[i + 2u].position;
+            let v = world_triangle(o, primitive);
+            let v0 = v[0];
+            let v1 = v[1];
+            let v2 = v[2];
             let su = sqrt(u.x);
             let b1 = 1.0 - su;
             let b2 = u.y * su;

@@ -7,6 +7,8 @@
 // distances, nearest on top, to be skipped on pop if a closer hit was found meanwhile. A walk
 // that would overflow the stack (the host caps it) starts again without one.
 // Leaves of triangles are tested in a loop of their own. Shadow rays stop at the first hit.
+// A placed instance is a primitive of a shape leaf: the ray, moved into its mesh's space,
+// walks the mesh's tree (`trace_mesh`, the same walk without shapes, on a stack of its own).
 // CPU twin: `crates/cpu/src/bvh.rs` (whose walk tests a node's leaves as it visits the node;
 // the hits are the same).
 //
@@ -16,6 +18,7 @@
 
 #import scene
 #import intersect
+#import instance
 #import textures
 
 const ACCEL_BVH: u32 = 0u;
@@ -93,12 +96,34 @@ fn intersect_primitive(i: u32, ray: Ray, sheared: ShearedRay, hit: ptr<function,
     hit_triangle(p.object, p.triangle, p.v0, p.v1, p.v2, sheared, hit);
 }
 
-// Nearest hit among primitives `first .. first + count`, all triangles.
-fn intersect_triangles(first: u32, count: u32, ray: ShearedRay, hit: ptr<function, Hit>) {
+// Primitive `i` of a top-level shape leaf: an instance is walked (`trace_instance`), a shape
+// or a triangle tested.
+fn intersect_top_level(i: u32, ray: Ray, sheared: ShearedRay, any_hit: bool, hit: ptr<function, Hit>) {
+    let p = primitives[i];
+    if p.triangle == INSTANCE {
+        trace_instance(p, ray, any_hit, hit);
+    } else {
+        intersect_primitive(i, ray, sheared, hit);
+    }
+}
+
+// Nearest hit among primitives `first .. first + count`, all triangles, as parts of their own
+// objects, or of instance object `object` unless it is NO_HIT.
+fn intersect_triangles(first: u32, count: u32, object: u32, ray: ShearedRay, hit: ptr<function, Hit>) {
     for (var i = first; i < first + count; i++) {
         let p = primitives[i];
-        hit_triangle(p.object, p.triangle, p.v0, p.v1, p.v2, ray, hit);
+        hit_triangle(select(object, p.object, object == NO_HIT), p.triangle, p.v0, p.v1, p.v2, ray, hit);
     }
+}
+
+// The walk through the tree of the instance that primitive `p` places, in its mesh's space:
+// the ray moved by the instance's `to_object` (its direction not renormalised, so distances
+// stay), the hits the instance object's.
+// CPU twin: `Walk::instance`.
+fn trace_instance(p: Primitive, ray: Ray, any_hit: bool, hit: ptr<function, Hit>) {
+    let m = instances[objects[p.object].instance];
+    let local = Ray(to_object_point(m, ray.origin), to_object_vector(m, ray.dir));
+    trace_mesh(p.root, p.object, local, any_hit, hit);
 }
 
 // Nearest hit among the triangles of mesh object `i`, read from `vertices`.
@@ -119,7 +144,13 @@ fn intersect_linear(ray: Ray, sheared: ShearedRay, inv_dir: vec3f, object_count:
             intersect_shape(i, o, ray, hit);
         } else if ACCEL == ACCEL_BRUTE_FORCE
             || intersect_aabb(Aabb(o.a.xyz, o.b.xyz), ray.origin, inv_dir, (*hit).t) != MISS {
-            intersect_mesh(i, o, sheared, hit);
+            if (o.flags & FLAG_INSTANCE) != 0u {
+                let m = instances[o.instance];
+                let local = Ray(to_object_point(m, ray.origin), to_object_vector(m, ray.dir));
+                intersect_mesh(i, o, sheared_ray(local), hit);
+            } else {
+                intersect_mesh(i, o, sheared, hit);
+            }
         }
         if any_hit && (*hit).object != NO_HIT {
             return;
@@ -186,7 +217,7 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
                 let first = n.first[lane];
                 let end = first + (n.count[lane] & ~SHAPE_LEAF);
                 for (var i = first; i < end; i++) {
-                    intersect_primitive(i, ray, sheared, &hit);
+                    intersect_top_level(i, ray, sheared, any_hit, &hit);
                 }
             }
             if any_hit && hit.object != NO_HIT {
@@ -194,67 +225,161 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
             }
         }
         // The other children still to visit (inner nodes, and leaves of triangles as LEAF
-        // entries) sorted by entry distance: a sorting network on four keys, MISS for those
-        // not entered before the current hit. The nearest is taken next, the others are
+        // entries), sorted by entry distance: the nearest is taken next, the others are
         // pushed, farthest first.
-        let leaves = vec4u(LEAF | (index << 2u)) | vec4u(0u, 1u, 2u, 3u);
-        let entries = select(n.first, leaves, n.count != vec4u(0u));
-        let take = t < vec4f(hit.t) & !at_once;
-        var k0 = select(MISS, t.x, take.x);
-        var k1 = select(MISS, t.y, take.y);
-        var k2 = select(MISS, t.z, take.z);
-        var k3 = select(MISS, t.w, take.w);
-        var c0 = entries.x;
-        var c1 = entries.y;
-        var c2 = entries.z;
-        var c3 = entries.w;
-        order_pair(&k0, &c0, &k1, &c1);
-        order_pair(&k2, &c2, &k3, &c3);
-        order_pair(&k0, &c0, &k2, &c2);
-        order_pair(&k1, &c1, &k3, &c3);
-        order_pair(&k1, &c1, &k2, &c2);
-        let pushes = u32(k1 != MISS) + u32(k2 != MISS) + u32(k3 != MISS);
+        let o = order_children(n, index, t, t < vec4f(hit.t) & !at_once);
+        let pushes = u32(o.keys.y != MISS) + u32(o.keys.z != MISS) + u32(o.keys.w != MISS);
         if sp + pushes > STACK_SIZE {
             // Deeper than the stack: walk again from the root without one, keeping the hit.
             trace_stackless(ray, sheared, inv_dir, backwards, any_hit, &hit);
             return hit;
         }
-        if k3 != MISS {
-            stack[sp] = vec2u(c3, bitcast<u32>(k3));
-            sp++;
-        }
-        if k2 != MISS {
-            stack[sp] = vec2u(c2, bitcast<u32>(k2));
-            sp++;
-        }
-        if k1 != MISS {
-            stack[sp] = vec2u(c1, bitcast<u32>(k1));
-            sp++;
-        }
-        var next = c0;
-        if k0 == MISS {
-            next = pop_entry(&stack, &sp, hit.t);
-        }
+        let next = push_children(&stack, &sp, o, hit.t);
         // Leaves of triangles, nearest first, until the next inner node ("while-while", Aila
         // and Laine: a warp's lanes intersect triangles together, then walk nodes together).
+        var entry = next;
         loop {
-            if next == NO_NODE {
+            if entry == NO_NODE {
                 return hit;
             }
-            if (next & LEAF) == 0u {
+            if (entry & LEAF) == 0u {
                 break;
             }
-            let node = (next & ~LEAF) >> 2u;
-            let lane = next & 3u;
-            intersect_triangles(nodes[node].first[lane], nodes[node].count[lane], sheared, &hit);
+            let node = (entry & ~LEAF) >> 2u;
+            let lane = entry & 3u;
+            intersect_triangles(nodes[node].first[lane], nodes[node].count[lane], NO_HIT, sheared, &hit);
             if any_hit && hit.object != NO_HIT {
                 return hit;
             }
-            next = pop_entry(&stack, &sp, hit.t);
+            entry = pop_entry(&stack, &sp, hit.t);
         }
-        index = next;
+        index = entry;
     }
     return hit;
+}
+
+// The children of node `n` (at `index`) that `take` selects, sorted by their entry distances
+// `t` (a sorting network on four keys; MISS for the others): inner nodes by index, leaves as
+// LEAF entries.
+struct OrderedChildren {
+    keys: vec4f,
+    entries: vec4u,
+}
+
+fn order_children(n: WideNode, index: u32, t: vec4f, take: vec4<bool>) -> OrderedChildren {
+    let leaves = vec4u(LEAF | (index << 2u)) | vec4u(0u, 1u, 2u, 3u);
+    let entries = select(n.first, leaves, n.count != vec4u(0u));
+    var k0 = select(MISS, t.x, take.x);
+    var k1 = select(MISS, t.y, take.y);
+    var k2 = select(MISS, t.z, take.z);
+    var k3 = select(MISS, t.w, take.w);
+    var c0 = entries.x;
+    var c1 = entries.y;
+    var c2 = entries.z;
+    var c3 = entries.w;
+    order_pair(&k0, &c0, &k1, &c1);
+    order_pair(&k2, &c2, &k3, &c3);
+    order_pair(&k0, &c0, &k2, &c2);
+    order_pair(&k1, &c1, &k3, &c3);
+    order_pair(&k1, &c1, &k2, &c2);
+    return OrderedChildren(vec4f(k0, k1, k2, k3), vec4u(c0, c1, c2, c3));
+}
+
+// Pushes the sorted children `o` but the nearest (which the caller has room for), farthest
+// first, and returns the next entry to visit: the nearest child, else the next popped one
+// nearer than `t` (NO_NODE when none is left).
+fn push_children(stack: ptr<function, array<vec2u, STACK_SIZE>>, sp: ptr<function, u32>, o: OrderedChildren, t: f32) -> u32 {
+    for (var k = 3; k >= 1; k--) {
+        if o.keys[k] != MISS {
+            (*stack)[*sp] = vec2u(o.entries[k], bitcast<u32>(o.keys[k]));
+            *sp += 1u;
+        }
+    }
+    if o.keys.x == MISS {
+        return pop_entry(stack, sp, t);
+    }
+    return o.entries.x;
+}
+
+// Nearest hit (or with `any_hit` the first) among the triangles of the shared mesh's tree at
+// `root`, as parts of instance object `object`, updating `hit`: `trace_scene`'s walk without
+// shapes, on a stack of its own (the host sizes it for the meshes' trees too).
+fn trace_mesh(root: u32, object: u32, ray: Ray, any_hit: bool, hit: ptr<function, Hit>) {
+    let inv_dir = safe_inverse(ray.dir);
+    let sheared = sheared_ray(ray);
+    let backwards = inv_dir < vec3f(0.0);
+    var stack: array<vec2u, STACK_SIZE>;
+    var sp = 0u;
+    var index = root;
+    loop {
+        let n = nodes[index];
+        let t = enter_children(n, ray.origin, inv_dir, backwards, (*hit).t);
+        let o = order_children(n, index, t, t < vec4f((*hit).t));
+        let pushes = u32(o.keys.y != MISS) + u32(o.keys.z != MISS) + u32(o.keys.w != MISS);
+        if sp + pushes > STACK_SIZE {
+            trace_mesh_stackless(root, object, ray, sheared, inv_dir, backwards, any_hit, hit);
+            return;
+        }
+        var entry = push_children(&stack, &sp, o, (*hit).t);
+        loop {
+            if entry == NO_NODE {
+                return;
+            }
+            if (entry & LEAF) == 0u {
+                break;
+            }
+            let node = (entry & ~LEAF) >> 2u;
+            let lane = entry & 3u;
+            intersect_triangles(nodes[node].first[lane], nodes[node].count[lane], object, sheared, hit);
+            if any_hit && (*hit).object != NO_HIT {
+                return;
+            }
+            entry = pop_entry(&stack, &sp, (*hit).t);
+        }
+        index = entry;
+    }
+}
+
+// `trace_stackless` for the shared mesh's tree at `root` (`trace_mesh`'s walk when it is
+// deeper than its stack), the hits instance object `object`'s.
+fn trace_mesh_stackless(root: u32, object: u32, ray: Ray, sheared: ShearedRay, inv_dir: vec3f, backwards: vec3<bool>, any_hit: bool, hit: ptr<function, Hit>) {
+    var index = root;
+    var from_lane = 4u;
+    loop {
+        let n = nodes[index];
+        let t = enter_children(n, ray.origin, inv_dir, backwards, (*hit).t);
+        if from_lane == 4u {
+            for (var lane = 0u; lane < 4u; lane++) {
+                if n.count[lane] != 0u && t[lane] < (*hit).t {
+                    intersect_triangles(n.first[lane], n.count[lane], object, sheared, hit);
+                }
+            }
+            if any_hit && (*hit).object != NO_HIT {
+                return;
+            }
+        }
+        let next = next_stackless(n, t, from_lane, (*hit).t);
+        if next != NO_NODE {
+            index = next;
+            from_lane = 4u;
+        } else if index == root {
+            return;
+        } else {
+            from_lane = parents[index] & 3u;
+            index = parents[index] >> 2u;
+        }
+    }
+}
+
+// The stackless walks' next inner child of `n` after lane `from_lane` (from the first when it
+// is 4) that the ray enters before `t_max` (entry distances `t`), or NO_NODE.
+fn next_stackless(n: WideNode, t: vec4f, from_lane: u32, t_max: f32) -> u32 {
+    for (var lane = select(from_lane + 1u, 0u, from_lane == 4u); lane < 4u; lane++) {
+        if n.count[lane] == 0u && t[lane] < t_max {
+            return n.first[lane];
+        }
+    }
+    return NO_NODE;
 }
 
 // The walk of `trace_scene` for trees deeper than its stack: children in lane order, going
@@ -277,20 +402,14 @@ fn trace_stackless(ray: Ray, sheared: ShearedRay, inv_dir: vec3f, backwards: vec
                 let first = n.first[lane];
                 let end = first + (n.count[lane] & ~SHAPE_LEAF);
                 for (var i = first; i < end; i++) {
-                    intersect_primitive(i, ray, sheared, hit);
+                    intersect_top_level(i, ray, sheared, any_hit, hit);
                 }
             }
             if any_hit && (*hit).object != NO_HIT {
                 return;
             }
         }
-        var next = NO_NODE;
-        for (var lane = select(from_lane + 1u, 0u, from_lane == 4u); lane < 4u; lane++) {
-            if n.count[lane] == 0u && t[lane] < (*hit).t {
-                next = n.first[lane];
-                break;
-            }
-        }
+        let next = next_stackless(n, t, from_lane, (*hit).t);
         if next != NO_NODE {
             index = next;
             from_lane = 4u;

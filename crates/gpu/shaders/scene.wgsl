@@ -11,6 +11,8 @@ const KIND_MESH: u32 = 3u;
 const FLAG_FLAT: u32 = 1u;
 const FLAG_CAPS: u32 = 2u;
 const FLAG_ALPHA: u32 = 4u;
+const FLAG_INSTANCE: u32 = 8u;
+const FLAG_MIRRORED: u32 = 16u;
 
 // One object, in the scene's order (a mesh's box is `a.xyz` to `b.xyz`). Host: `GpuObject`.
 struct Object {
@@ -26,8 +28,9 @@ struct Object {
     first_triangle: u32,
     // Mesh: how many triangles it has.
     triangle_count: u32,
-    pad0: u32,
-    pad1: u32,
+    // An instance (FLAG_INSTANCE): its entry in `instances`.
+    instance: u32,
+    pad: u32,
 }
 
 const NO_LIGHT: u32 = 0xffffffffu;
@@ -82,10 +85,18 @@ struct Primitive {
     v1: vec3f,
     triangle: u32,
     v2: vec3f,
-    pad: u32,
+    // An instance (triangle = INSTANCE): the root node of its mesh's tree.
+    root: u32,
 }
 
 const NO_TRIANGLE: u32 = 0xffffffffu;
+const INSTANCE: u32 = 0xfffffffeu;
+
+// The placement of an instance: rows of its affine transforms, each (x, y, z, translation).
+struct Instance {
+    to_object: array<vec4f, 3>,
+    to_world: array<vec4f, 3>,
+}
 const SHAPE_LEAF: u32 = 0x80000000u;
 
 // Vectors of a model's parameter block (host: `MODEL_PARAMS`); the last is loaded only for
@@ -160,3 +171,5 @@ struct Material {
 // The parameter blocks: the sheen albedo table and the materials'
 // (`pathlight_core::materials`), then the point and sun lights' (`pathlight_core::light_table`).
 @group(0) @binding(11) var<storage, read> param_blocks: array<vec4f>;
+// The placements of instances (`Object::instance` indexes them).
+@group(0) @binding(12) var<storage, read> instances: array<Instance>;

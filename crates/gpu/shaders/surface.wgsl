@@ -5,6 +5,7 @@
 #import scene
 #import textures
 #import intersect
+#import instance
 #import bvh
 #import sampling
 
@@ -125,8 +126,15 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
             let v1 = vertices[i + 1u];
             let v2 = vertices[i + 2u];
             let b0 = 1.0 - hit.b1 - hit.b2;
-            s.ng = normalize(cross(v1.position - v0.position, v2.position - v0.position));
-            let n = b0 * decode_unit(v0.normal) + hit.b1 * decode_unit(v1.normal) + hit.b2 * decode_unit(v2.normal);
+            let instanced = (o.flags & FLAG_INSTANCE) != 0u;
+            var ng = cross(v1.position - v0.position, v2.position - v0.position);
+            var n = b0 * decode_unit(v0.normal) + hit.b1 * decode_unit(v1.normal) + hit.b2 * decode_unit(v2.normal);
+            if instanced {
+                let placement = instances[o.instance];
+                ng = to_world_normal(placement, ng);
+                n = to_world_normal(placement, n);
+            }
+            s.ng = normalize(ng);
             s.uv = b0 * v0.uv + hit.b1 * v1.uv + hit.b2 * v2.uv;
             s.color = triangle_color(hit.primitive, hit.b1, hit.b2).rgb;
             if (o.flags & FLAG_FLAT) != 0u || dot(n, n) < 1e-12 {
@@ -141,9 +149,13 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
             let side = select(-1.0, 1.0, dot(wo, s.ng) >= 0.0);
             if (m.texture_mask & ((1u << TEXTURE_NORMAL) | (1u << TEXTURE_COAT_NORMAL))) != 0u {
                 tangent = b0 * decode_unit(v0.tangent) + hit.b1 * decode_unit(v1.tangent) + hit.b2 * decode_unit(v2.tangent);
+                if instanced {
+                    tangent = to_world_vector(instances[o.instance], tangent);
+                }
             }
+            let sign = tangent_sign(v0.tangent) * select(1.0, -1.0, (o.flags & FLAG_MIRRORED) != 0u);
             if has_texture(m, TEXTURE_NORMAL) {
-                s.ns = normal_mapped(m, TEXTURE_NORMAL, m.normal_scale, s.uv, s.ns, tangent, tangent_sign(v0.tangent));
+                s.ns = normal_mapped(m, TEXTURE_NORMAL, m.normal_scale, s.uv, s.ns, tangent, sign);
                 s.ns = side * valid_reflection_normal(side * s.ng, wo, side * s.ns);
             }
             if dot(s.ns, s.ng) < 0.0 {
@@ -151,7 +163,7 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
             }
             s.nc = s.ns;
             if has_texture(m, TEXTURE_COAT_NORMAL) {
-                s.nc = normal_mapped(m, TEXTURE_COAT_NORMAL, m.coat_normal_scale, s.uv, interpolated, tangent, tangent_sign(v0.tangent));
+                s.nc = normal_mapped(m, TEXTURE_COAT_NORMAL, m.coat_normal_scale, s.uv, interpolated, tangent, sign);
                 s.nc = side * valid_reflection_normal(side * s.ng, wo, side * s.nc);
                 if dot(s.nc, s.ng) < 0.0 {
                     s.nc = -s.nc;

@@ -15,7 +15,7 @@ use crate::pipeline::{bind_buffers, storage_entry};
 const MAX_NODES: usize = 1 << 28;
 
 /// Bindings of `scene.wgsl` and `environment.wgsl`, by number.
-const BINDINGS: usize = 12;
+const BINDINGS: usize = 13;
 
 /// The scene's buffers on the device and the bind group over them.
 #[derive(Debug)]
@@ -53,9 +53,9 @@ fn storage_buffer(
     )
 }
 
-/// The geometry buffers: bindings 0 (nodes), 2 (vertices), 7 (primitives) and 8 (the
-/// nodes' parents).
-fn geometry_contents(geometry: &Geometry) -> [(usize, &'static str, &[u8]); 4] {
+/// The geometry buffers: bindings 0 (nodes), 2 (vertices), 7 (primitives), 8 (the
+/// nodes' parents) and 12 (the instances' placements).
+fn geometry_contents(geometry: &Geometry) -> [(usize, &'static str, &[u8]); 5] {
     // A binding is never empty: a placeholder when there are no primitives.
     const PLACEHOLDER: [GpuPrimitive; 1] = [GpuPrimitive {
         v0: [0.0; 3],
@@ -63,7 +63,7 @@ fn geometry_contents(geometry: &Geometry) -> [(usize, &'static str, &[u8]); 4] {
         v1: [0.0; 3],
         triangle: 0,
         v2: [0.0; 3],
-        pad: 0,
+        root: 0,
     }];
     let primitives = if geometry.primitives.is_empty() {
         bytemuck::cast_slice(&PLACEHOLDER)
@@ -75,6 +75,7 @@ fn geometry_contents(geometry: &Geometry) -> [(usize, &'static str, &[u8]); 4] {
         (2, "vertices", bytemuck::cast_slice(&geometry.vertices)),
         (7, "primitives", primitives),
         (8, "bvh parents", bytemuck::cast_slice(&geometry.parents)),
+        (12, "instances", bytemuck::cast_slice(&geometry.instances)),
     ]
 }
 

@@ -7,7 +7,7 @@ use std::mem::{offset_of, size_of};
 
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use pathlight_core::gpu_types::{
-    GpuAccumPixel, GpuCamera, GpuLight, GpuMaterial, GpuObject, GpuPrimitive, GpuRenderParams,
+    GpuAccumPixel, GpuCamera, GpuInstance, GpuLight, GpuMaterial, GpuObject, GpuPrimitive, GpuRenderParams,
     GpuTextureSlot, GpuVertex, GpuWideNode,
 };
 use pathlight_gpu::display::GpuDisplayParams;
@@ -117,9 +117,11 @@ fn host_structs_match_their_wgsl_declarations() {
             flags,
             light,
             first_triangle,
-            triangle_count
+            triangle_count,
+            instance
         ]
     );
+    assert_layout!(m, "Instance", GpuInstance, [to_object, to_world]);
     assert_layout!(m, "Light", GpuLight, [kind, index, primitive, cdf, pmf]);
     assert_layout!(
         m,
@@ -143,7 +145,7 @@ fn host_structs_match_their_wgsl_declarations() {
         m,
         "Primitive",
         GpuPrimitive,
-        [v0, object, v1, triangle, v2, pad]
+        [v0, object, v1, triangle, v2, root]
     );
     assert_layout!(
         m,

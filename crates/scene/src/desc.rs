@@ -424,6 +424,22 @@ pub struct MeshDesc {
     /// Placement in the world.
     #[serde(default)]
     pub transform: TransformDesc,
+    /// Further placements of the same mesh, which share one copy of its triangles.
+    #[serde(default)]
+    pub instances: Vec<InstanceDesc>,
+}
+
+/// One more placement of a `[[mesh]]` entry's mesh.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InstanceDesc {
+    /// Optional name, shown when picked (default: the mesh's name and `#` and its number).
+    pub name: Option<String>,
+    /// Material name (default: the mesh's).
+    pub material: Option<String>,
+    /// Placement in the world of the OBJ file's own coordinates.
+    #[serde(default)]
+    pub transform: TransformDesc,
 }
 
 /// Normals used for shading a mesh.

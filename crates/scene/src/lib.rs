@@ -32,7 +32,7 @@ pub use material::{
     AlphaMode, Conductor, LayerTextures, Lobes, Material, MetalRough, Model, TextureRef, Wrap,
 };
 pub use settings::{RenderSettings, Sampler};
-pub use shape::{Object, Shape, TriangleMesh};
+pub use shape::{Instance, Object, Shape, TriangleMesh};
 pub use texture::Texture;
 
 /// A scene ready to be prepared for rendering: resolved, validated, in world space and

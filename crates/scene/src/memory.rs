@@ -10,6 +10,40 @@ use std::fmt;
 /// texture coordinates.
 pub const BYTES_PER_TRIANGLE: u64 = 320;
 
+/// Bytes a placement of a shared mesh costs beyond its mesh, rounded up: its object in the
+/// scene (name, shape) and in the backends (object record, transforms, top-level primitive
+/// and its share of the top-level tree).
+pub const BYTES_PER_INSTANCE: u64 = 512;
+
+/// How much geometry a scene holds: the triangles it keeps (a shared mesh's once) and the
+/// placements of shared meshes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SceneSize {
+    /// Triangles kept, each shared mesh's counted once.
+    pub triangles: u64,
+    /// Placements of shared meshes.
+    pub instances: u64,
+}
+
+impl SceneSize {
+    /// About the bytes the scene needs at its peak.
+    pub fn bytes(&self) -> u64 {
+        self.triangles
+            .saturating_mul(BYTES_PER_TRIANGLE)
+            .saturating_add(self.instances.saturating_mul(BYTES_PER_INSTANCE))
+    }
+}
+
+impl fmt::Display for SceneSize {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} triangles", self.triangles)?;
+        if self.instances > 0 {
+            write!(f, " and {} instances", self.instances)?;
+        }
+        Ok(())
+    }
+}
+
 /// The environment variable that sets the memory a scene may use: bytes, or a number with
 /// the suffix K, M, G or T (powers of 1024). Without it, the memory available now.
 pub const LIMIT_VARIABLE: &str = "PATHLIGHT_MEMORY_LIMIT";
@@ -54,10 +88,10 @@ impl Budget {
         }))
     }
 
-    /// Refuses `triangles` triangles when they need more than this budget: the message says
-    /// how many bytes they need and how many there are.
-    pub fn check(&self, triangles: u64) -> Result<(), String> {
-        let needed = triangles.saturating_mul(BYTES_PER_TRIANGLE);
+    /// Refuses a scene of `size` when it needs more than this budget: the message says
+    /// how many bytes it needs and how many there are.
+    pub fn check(&self, size: SceneSize) -> Result<(), String> {
+        let needed = size.bytes();
         if needed <= self.bytes {
             return Ok(());
         }
@@ -66,18 +100,24 @@ impl Budget {
         } else {
             format!("the machine has available ({LIMIT_VARIABLE} sets another limit)")
         };
+        let each = if size.instances > 0 {
+            format!("about {BYTES_PER_TRIANGLE} bytes a triangle, {BYTES_PER_INSTANCE} an instance")
+        } else {
+            format!("about {BYTES_PER_TRIANGLE} bytes each")
+        };
         Err(format!(
-            "{triangles} triangles need about {} (about {BYTES_PER_TRIANGLE} bytes each), more than the {} {source}",
+            "{size} need about {} ({each}), more than the {} {source}",
             Bytes(needed),
             Bytes(self.bytes)
         ))
     }
 }
 
-/// Checks `triangles` against this process's budget (nothing to check where none is known).
-pub fn check_triangles(triangles: u64) -> Result<(), String> {
+/// Checks a scene of `size` against this process's budget (nothing to check where none is
+/// known).
+pub fn check_size(size: SceneSize) -> Result<(), String> {
     match Budget::of_this_process()? {
-        Some(budget) => budget.check(triangles),
+        Some(budget) => budget.check(size),
         None => Ok(()),
     }
 }
@@ -162,11 +202,30 @@ mod tests {
             bytes: 1 << 30,
             from_variable: true,
         };
-        assert!(budget.check((1 << 30) / BYTES_PER_TRIANGLE).is_ok());
-        let message = budget.check(10_000_000).unwrap_err();
+        let triangles = |triangles| SceneSize {
+            triangles,
+            instances: 0,
+        };
+        assert!(budget.check(triangles((1 << 30) / BYTES_PER_TRIANGLE)).is_ok());
+        let message = budget.check(triangles(10_000_000)).unwrap_err();
         assert_eq!(
             message,
             "10000000 triangles need about 3.0 GiB (about 320 bytes each), more than the 1.0 GiB PATHLIGHT_MEMORY_LIMIT allows"
+        );
+        // A mesh of 10,000 triangles placed 10,000 times: its triangles once, and the
+        // placements.
+        let instanced = SceneSize {
+            triangles: 10_000,
+            instances: 10_000,
+        };
+        assert!(budget.check(instanced).is_ok());
+        let many = SceneSize {
+            triangles: 10_000,
+            instances: 3_000_000,
+        };
+        assert_eq!(
+            budget.check(many).unwrap_err(),
+            "10000 triangles and 3000000 instances need about 1.4 GiB (about 320 bytes a triangle, 512 an instance), more than the 1.0 GiB PATHLIGHT_MEMORY_LIMIT allows"
         );
         assert_eq!(Bytes(1536).to_string(), "1.5 KiB");
         assert_eq!(Bytes(12).to_string(), "12 bytes");

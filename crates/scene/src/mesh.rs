@@ -138,4 +138,26 @@ impl TriangleMesh {
             *n = normal_matrix.transform_vector3(*n).normalize_or_zero();
         }
     }
+
+    /// Moves the mesh by `world` as a glTF node or an instance places it: as
+    /// [`Self::transform`], tangents by the matrix; a mirroring matrix (negative
+    /// determinant) reverses every triangle, so that counter-clockwise stays the front, and
+    /// flips the bitangent signs.
+    pub fn place(&mut self, world: Mat4) {
+        self.transform(world);
+        let linear = glam::Mat3::from_mat4(world);
+        let mirrored = linear.determinant() < 0.0;
+        for t in &mut self.tangents {
+            let direction = (linear * t.truncate()).normalize_or_zero();
+            *t = direction.extend(if mirrored { -t.w } else { t.w });
+        }
+        if mirrored {
+            for tri in &mut self.indices {
+                tri.swap(1, 2);
+            }
+            for corners in self.tangents.chunks_exact_mut(3) {
+                corners.swap(1, 2);
+            }
+        }
+    }
 }

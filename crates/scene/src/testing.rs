@@ -1,13 +1,15 @@
 //! Random and hand-made scenes for tests of the crates that prepare and trace scenes
 //! (feature `test-support`).
 
-use glam::{Vec2, Vec3};
+use std::sync::Arc;
+
+use glam::{Affine3A, Quat, Vec2, Vec3};
 use rand::Rng;
 use rand::rngs::StdRng;
 
 use crate::{
-    Camera, Environment, Lobes, Material, Model, Object, RenderSettings, Sampler, Scene, Shape,
-    TriangleMesh,
+    Camera, Environment, Instance, Lobes, Material, Model, Object, RenderSettings, Sampler, Scene,
+    Shape, TriangleMesh,
 };
 
 /// A scene of `objects` in one grey diffuse material (index 0), seen from +z by an 8x8
@@ -118,6 +120,60 @@ pub fn mesh_of(triangles: &[[Vec3; 3]]) -> TriangleMesh {
         mesh.indices.push([i, i + 1, i + 2]);
     }
     mesh
+}
+
+/// `mesh` placed by each of `placements`, as instances sharing one copy of it named
+/// `name#k`, in material 0.
+pub fn instances_of(name: &str, mesh: TriangleMesh, placements: &[Affine3A]) -> Vec<Object> {
+    let mesh = Arc::new(mesh);
+    placements
+        .iter()
+        .enumerate()
+        .map(|(k, &to_world)| {
+            object(
+                &format!("{name}#{k}"),
+                Shape::Instance(Instance {
+                    mesh: mesh.clone(),
+                    to_world,
+                }),
+            )
+        })
+        .collect()
+}
+
+/// `count` random placements within about 3 of the origin: rotated, scaled unevenly (0.3 to
+/// 1.5 per axis), every third one mirrored.
+pub fn random_placements(rng: &mut StdRng, count: usize) -> Vec<Affine3A> {
+    (0..count)
+        .map(|k| {
+            let axis = random_point(rng, 1.0).normalize_or(Vec3::Y);
+            let rotation = Quat::from_axis_angle(axis, rng.random_range(0.0..6.0));
+            let mut scale = Vec3::new(
+                rng.random_range(0.3..1.5),
+                rng.random_range(0.3..1.5),
+                rng.random_range(0.3..1.5),
+            );
+            if k % 3 == 2 {
+                scale.x = -scale.x;
+            }
+            Affine3A::from_scale_rotation_translation(scale, rotation, random_point(rng, 3.0))
+        })
+        .collect()
+}
+
+/// `objects` with every instance's mesh copied into the world ([`Instance::flattened`]):
+/// what the instances look like.
+pub fn flattened(objects: &[Object]) -> Vec<Object> {
+    objects
+        .iter()
+        .map(|o| match &o.shape {
+            Shape::Instance(instance) => Object {
+                shape: Shape::Mesh(instance.flattened()),
+                ..o.clone()
+            },
+            _ => o.clone(),
+        })
+        .collect()
 }
 
 /// An object named `name` in material 0.

@@ -1,5 +1,6 @@
 //! glTF 2.0 import (`.gltf` with its buffers and images, `.glb`, `data:` URIs): the
-//! triangles of every node of the default scene in world space, their metal-rough
+//! triangles of every node of the default scene (in world space, or as instances of one copy
+//! where nodes share a mesh), their metal-rough
 //! materials and textures, the scene's perspective cameras and its punctual lights
 //! (`KHR_lights_punctual`). Malformed files are refused
 //! naming the element (mesh, primitive, accessor, buffer, image, node); points and lines
@@ -12,15 +13,17 @@ mod primitives;
 
 use std::collections::HashMap;
 use std::path::Path;
+use std::sync::Arc;
 
-use glam::{Mat4, Vec3};
+use glam::{Affine3A, Mat4, Vec3};
 
 use crate::desc::RenderDesc;
 use crate::error::SceneError;
+use crate::memory::SceneSize;
 use crate::settings::MAX_COORDINATE;
 use crate::{
-    Camera, Cone, Environment, Light, LightKind, Material, Object, RenderSettings, Scene, Shape,
-    Texture, TriangleMesh,
+    Camera, Cone, Environment, Instance, Light, LightKind, Material, Object, RenderSettings,
+    Scene, Shape, Texture, TriangleMesh,
 };
 use data::Files;
 use materials::Materials;
@@ -70,12 +73,12 @@ impl GltfModel {
         self.objects
             .iter()
             .filter_map(|o| match &o.shape {
-                Shape::Mesh(m) => Some(&m.positions),
+                Shape::Mesh(m) => Some(m.bounds()),
+                Shape::Instance(instance) => Some(instance.bounds()),
                 _ => None,
             })
-            .flatten()
-            .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| {
-                (lo.min(p), hi.max(p))
+            .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), (min, max)| {
+                (lo.min(min), hi.max(max))
             })
     }
 }
@@ -128,7 +131,7 @@ pub fn load_gltf(path: &Path, transform: Mat4) -> Result<GltfModel, SceneError> 
         ancestors: Vec::new(),
         instances: 0,
         uses: HashMap::new(),
-        read: HashMap::new(),
+        shared: HashMap::new(),
         stem: path
             .file_stem()
             .map_or_else(|| "gltf".to_owned(), |s| s.to_string_lossy().into_owned()),
@@ -191,15 +194,16 @@ struct Walk<'a> {
     instances: usize,
     /// The file's name without extension, prefixing object names.
     stem: String,
-    /// Per mesh, the placements still to come (from [`count_uses`]).
+    /// Per mesh, how often the scene places it (from [`count_uses`]).
     uses: HashMap<usize, usize>,
-    /// Per (mesh, primitive), its triangles in the mesh's own space (`None`: skipped), read
-    /// once and kept while further placements of the mesh are to come.
-    read: HashMap<(usize, usize), Option<TriangleMesh>>,
+    /// Per (mesh, primitive) of a mesh placed more than once, its triangles in the mesh's own
+    /// space (`None`: skipped), read once and shared by its instances.
+    shared: HashMap<(usize, usize), Option<Arc<TriangleMesh>>>,
 }
 
-/// Refuses a scene whose placed triangles (`uses`: placements per mesh) need more memory
-/// than this process may use ([`crate::memory`]), before any is read.
+/// Refuses a scene whose triangles and instances (`uses`: placements per mesh; a mesh placed
+/// more than once is kept once and instanced) need more memory than this process may use
+/// ([`crate::memory`]), before any is read.
 fn check_memory(
     files: &Files,
     document: &gltf::Document,
@@ -223,12 +227,17 @@ fn check_memory(
             })
             .sum()
     };
-    let mut triangles = 0u64;
+    let mut size = SceneSize::default();
     for mesh in document.meshes() {
         let placed = uses.get(&mesh.index()).copied().unwrap_or(0) as u64;
-        triangles = triangles.saturating_add(placed.saturating_mul(triangles_of(mesh)));
+        if placed > 0 {
+            size.triangles = size.triangles.saturating_add(triangles_of(mesh));
+        }
+        if placed > 1 {
+            size.instances = size.instances.saturating_add(placed);
+        }
     }
-    crate::memory::check_triangles(triangles).map_err(|message| {
+    crate::memory::check_size(size).map_err(|message| {
         let placements: usize = uses.values().sum();
         files.error(
             &format!("scene {}", scene.index()),
@@ -412,42 +421,53 @@ impl Walk<'_> {
         Ok(())
     }
 
-    /// Places `mesh` by `world`: each primitive read once however often the mesh is placed
-    /// (and warned about once), copied for every placement but the last, which takes it.
+    /// Places `mesh` by `world`: a mesh the scene places once as world-space triangles, one
+    /// placed more often as instances of its triangles (each primitive read, and warned
+    /// about, once).
     fn mesh(&mut self, mesh: &gltf::Mesh, world: Mat4) -> Result<(), SceneError> {
-        let remaining = self.uses.entry(mesh.index()).or_insert(1);
-        *remaining = remaining.saturating_sub(1);
-        let last = *remaining == 0;
+        let instanced = self.uses.get(&mesh.index()).is_some_and(|&n| n > 1);
         for primitive in mesh.primitives() {
             let (material, needs) =
                 self.materials
                     .get(self.files, self.buffers, &primitive.material())?;
             let key = (mesh.index(), primitive.index());
-            let cached = if last {
-                self.read.remove(&key)
-            } else {
-                self.read.get(&key).cloned()
-            };
-            let triangles = match cached {
-                Some(triangles) => triangles,
-                None => {
-                    let triangles = primitives::read_primitive(
-                        self.files,
-                        self.buffers,
-                        mesh.index(),
-                        &primitive,
-                        needs,
-                    )?;
-                    if !last {
-                        self.read.insert(key, triangles.clone());
+            let shape = if instanced {
+                let triangles = match self.shared.get(&key) {
+                    Some(triangles) => triangles.clone(),
+                    None => {
+                        let triangles = primitives::read_primitive(
+                            self.files,
+                            self.buffers,
+                            mesh.index(),
+                            &primitive,
+                            needs,
+                        )?
+                        .map(Arc::new);
+                        self.shared.insert(key, triangles.clone());
+                        triangles
                     }
-                    triangles
-                }
+                };
+                let Some(triangles) = triangles else {
+                    continue;
+                };
+                Shape::Instance(Instance {
+                    mesh: triangles,
+                    to_world: Affine3A::from_mat4(world),
+                })
+            } else {
+                let Some(mut triangles) = primitives::read_primitive(
+                    self.files,
+                    self.buffers,
+                    mesh.index(),
+                    &primitive,
+                    needs,
+                )?
+                else {
+                    continue;
+                };
+                triangles.place(world);
+                Shape::Mesh(triangles)
             };
-            let Some(mut triangles) = triangles else {
-                continue;
-            };
-            primitives::place(&mut triangles, world);
             let name = format!(
                 "{}/{}#{}.{}",
                 self.stem,
@@ -459,7 +479,7 @@ impl Walk<'_> {
             self.model.objects.push(Object {
                 name,
                 material,
-                shape: Shape::Mesh(triangles),
+                shape,
             });
         }
         Ok(())

@@ -210,27 +210,6 @@ pub(super) fn read_primitive(
     Ok(Some(mesh))
 }
 
-/// Moves `mesh` by the node's world matrix: normals by its inverse transpose, tangents by
-/// the matrix; a mirroring matrix (negative determinant) reverses every triangle, so that
-/// counter-clockwise stays the front, and flips the bitangent signs.
-pub(super) fn place(mesh: &mut TriangleMesh, world: glam::Mat4) {
-    mesh.transform(world);
-    let linear = glam::Mat3::from_mat4(world);
-    let mirrored = linear.determinant() < 0.0;
-    for t in &mut mesh.tangents {
-        let direction = (linear * t.truncate()).normalize_or_zero();
-        *t = direction.extend(if mirrored { -t.w } else { t.w });
-    }
-    if mirrored {
-        for tri in &mut mesh.indices {
-            tri.swap(1, 2);
-        }
-        for corners in mesh.tangents.chunks_exact_mut(3) {
-            corners.swap(1, 2);
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -271,7 +250,7 @@ mod tests {
             flat: false,
         };
         // Mirror x and move: the triangle's front (+z) must still be counter-clockwise.
-        place(&mut mesh, glam::Mat4::from_scale(Vec3::new(-2.0, 1.0, 1.0)));
+        mesh.place(glam::Mat4::from_scale(Vec3::new(-2.0, 1.0, 1.0)));
         let [a, b, c] = mesh.indices[0].map(|i| mesh.positions[i as usize]);
         let face = (b - a).cross(c - a).normalize();
         assert!(

@@ -4,7 +4,9 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
-use glam::{Vec2, Vec3};
+use std::sync::Arc;
+
+use glam::{Affine3A, Vec2, Vec3};
 use toml::Spanned;
 
 use super::{Builder, line_column};
@@ -13,7 +15,7 @@ use crate::error::SceneError;
 use crate::gltf_file::load_gltf;
 use crate::revolve::Revolution;
 use crate::settings::MAX_COORDINATE;
-use crate::{Light, Material, Object, Shape, TriangleMesh};
+use crate::{Instance, Light, Material, Object, Shape, TriangleMesh};
 
 impl Builder<'_, '_> {
     pub(super) fn objects(
@@ -94,7 +96,7 @@ impl Builder<'_, '_> {
         for (i, m) in desc.mesh.iter().enumerate() {
             let (span, d) = (m.span(), m.get_ref());
             spans.push(span.clone());
-            let material = material(span.clone(), &d.material)?;
+            let mesh_material = material(span.clone(), &d.material)?;
             let path = self.source.base_dir.join(&d.file);
             if !path.is_file() {
                 return Err(self.invalid(
@@ -103,15 +105,61 @@ impl Builder<'_, '_> {
                 ));
             }
             let mut mesh = crate::mesh::load_obj(&path)?;
-            mesh.transform(d.transform.to_matrix());
             mesh.flat = d.shading == Shading::Flat;
-            let what = format!("file = {:?} placed by its transform", d.file);
-            let mesh = self.checked_mesh(span, &what, mesh)?;
-            objects.push(Object {
-                name: named(&d.name, "mesh", i),
-                material,
-                shape: Shape::Mesh(mesh),
-            });
+            let name = named(&d.name, "mesh", i);
+            if d.instances.is_empty() {
+                mesh.transform(d.transform.to_matrix());
+                let what = format!("file = {:?} placed by its transform", d.file);
+                let mesh = self.checked_mesh(span, &what, mesh)?;
+                objects.push(Object {
+                    name,
+                    material: mesh_material,
+                    shape: Shape::Mesh(mesh),
+                });
+                continue;
+            }
+            let mesh = Arc::new(mesh);
+            let placements = std::iter::once((name.clone(), mesh_material, &d.transform));
+            let mut more = Vec::with_capacity(d.instances.len());
+            for (k, instance) in d.instances.iter().enumerate() {
+                let material = match &instance.material {
+                    Some(m) => material(span.clone(), m)?,
+                    None => mesh_material,
+                };
+                let name = instance
+                    .name
+                    .clone()
+                    .unwrap_or_else(|| format!("{name}#{}", k + 1));
+                more.push((name, material, &instance.transform));
+                spans.push(span.clone());
+            }
+            for (k, (name, material, transform)) in placements.chain(more).enumerate() {
+                let to_world = Affine3A::from_mat4(transform.to_matrix());
+                let instance = Instance {
+                    mesh: mesh.clone(),
+                    to_world,
+                };
+                let (min, max) = instance.bounds();
+                if !(min.abs().max(max.abs())).cmple(Vec3::splat(MAX_COORDINATE)).all() {
+                    let what = if k == 0 {
+                        "its transform".to_owned()
+                    } else {
+                        format!("instances[{}]", k - 1)
+                    };
+                    return Err(self.invalid(
+                        span,
+                        format!(
+                            "file = {:?} placed by {what} reaches {min} .. {max}, beyond +-{MAX_COORDINATE:e}",
+                            d.file
+                        ),
+                    ));
+                }
+                objects.push(Object {
+                    name,
+                    material,
+                    shape: Shape::Instance(instance),
+                });
+            }
         }
         for (i, r) in desc.revolve.iter().enumerate() {
             let (span, d) = (r.span(), r.get_ref());
