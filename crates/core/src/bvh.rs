@@ -177,7 +177,10 @@ fn collapse_node(
             let mark = if shape { SHAPE_LEAF } else { 0 };
             (primitive_base + c.first_index, c.prim_count | mark)
         } else {
-            (collapse_node(nodes, is_shape, primitive_base, child, out), 0)
+            (
+                collapse_node(nodes, is_shape, primitive_base, child, out),
+                0,
+            )
         };
         let n = &mut out[index as usize];
         let (lo, hi) = (c.aabb.min, c.aabb.max);

@@ -216,6 +216,11 @@ impl Geometry {
         self.vertices.len() / 3
     }
 
+    /// Whether any object is a placed instance of a shared mesh.
+    pub fn has_instances(&self) -> bool {
+        self.shapes.iter().any(|s| s.flags & FLAG_INSTANCE != 0)
+    }
+
     /// Number of triangles the scene shows (a shared mesh's once per placement).
     pub fn placed_triangle_count(&self) -> usize {
         self.shapes.iter().map(|s| s.triangle_count as usize).sum()
@@ -291,7 +296,6 @@ impl Geometry {
     }
 }
 
-
 impl Geometry {
     /// Appends the tree of shared mesh `mesh` (its triangles in its own space) to the nodes,
     /// its triangles in leaf order to the primitives and the vertex buffer (the primitives
@@ -315,23 +319,24 @@ impl Geometry {
                 .par_iter()
                 .flat_map_iter(|&t| triangle_vertices(mesh, t)),
         );
-        self.primitives.par_extend(
-            tree.primitive_indices
-                .par_iter()
-                .enumerate()
-                .map(|(slot, &t)| {
-                    let [v0, v1, v2] = mesh.indices[t as usize]
-                        .map(|v| mesh.positions[v as usize].to_array());
-                    GpuPrimitive {
-                        v0,
-                        object,
-                        v1,
-                        triangle: first_triangle + slot as u32,
-                        v2,
-                        root: 0,
-                    }
-                }),
-        );
+        self.primitives
+            .par_extend(
+                tree.primitive_indices
+                    .par_iter()
+                    .enumerate()
+                    .map(|(slot, &t)| {
+                        let [v0, v1, v2] =
+                            mesh.indices[t as usize].map(|v| mesh.positions[v as usize].to_array());
+                        GpuPrimitive {
+                            v0,
+                            object,
+                            v1,
+                            triangle: first_triangle + slot as u32,
+                            v2,
+                            root: 0,
+                        }
+                    }),
+            );
         Some((root, first_triangle))
     }
 }
@@ -619,8 +624,8 @@ mod tests {
     use super::Geometry;
     use crate::bvh::{self, lane_used};
     use crate::gpu_types::{
-        FLAG_INSTANCE, FLAG_MIRRORED, GpuInstance, GpuObject, GpuPrimitive, GpuVertex,
-        GpuWideNode, INSTANCE, KIND_MESH, NO_TRIANGLE, SHAPE_LEAF,
+        FLAG_INSTANCE, FLAG_MIRRORED, GpuInstance, GpuObject, GpuPrimitive, GpuVertex, GpuWideNode,
+        INSTANCE, KIND_MESH, NO_TRIANGLE, SHAPE_LEAF,
     };
 
     #[test]
@@ -720,8 +725,12 @@ mod tests {
                         if prim.triangle == INSTANCE {
                             assert!(placed_by.is_none(), "an instance inside a mesh's tree");
                             assert_ne!(owner.flags & FLAG_INSTANCE, 0, "primitive {p}");
-                            let (min, max) = (Vec3::from_slice(&owner.a), Vec3::from_slice(&owner.b));
-                            assert!(contains(&n, lane, min, max), "placement {p} escapes its leaf");
+                            let (min, max) =
+                                (Vec3::from_slice(&owner.a), Vec3::from_slice(&owner.b));
+                            assert!(
+                                contains(&n, lane, min, max),
+                                "placement {p} escapes its leaf"
+                            );
                             assert_eq!(g.parents[prim.root as usize], bvh::NO_PARENT);
                             trees.push((prim.root, Some(prim.object)));
                             continue;
@@ -767,7 +776,10 @@ mod tests {
                 shape.kind != KIND_MESH || shape.flags & FLAG_INSTANCE != 0
             })
             .collect();
-        assert_eq!(shapes, expected, "every shape and placement is one primitive");
+        assert_eq!(
+            shapes, expected,
+            "every shape and placement is one primitive"
+        );
         let mut triangles: Vec<u32> = g
             .primitives
             .iter()
@@ -787,13 +799,22 @@ mod tests {
         let mut rng = StdRng::seed_from_u64(29);
         let mut objects = random_objects(&mut rng, 20);
         let rocks = random_placements(&mut rng, 50);
-        objects.extend(instances_of("rocks", random_mesh(&mut rng, 500, Vec3::ZERO), &rocks));
+        objects.extend(instances_of(
+            "rocks",
+            random_mesh(&mut rng, 500, Vec3::ZERO),
+            &rocks,
+        ));
         let balls = random_placements(&mut rng, 7);
         objects.extend(instances_of("balls", icosphere(2), &balls));
         let g = Geometry::build(&objects).unwrap();
         validate(&g);
         assert_eq!(g.instances.len(), 57);
-        for (k, o) in g.shapes.iter().enumerate().filter(|(_, o)| o.flags & FLAG_INSTANCE != 0) {
+        for (k, o) in g
+            .shapes
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| o.flags & FLAG_INSTANCE != 0)
+        {
             let mirrored = o.flags & FLAG_MIRRORED != 0;
             let Shape::Instance(instance) = &objects[k].shape else {
                 panic!("object {k} is not an instance")
@@ -827,7 +848,10 @@ mod tests {
             (224.0..260.0).contains(&per_placement),
             "{per_placement:.1} B a placement"
         );
-        assert!(few > 10_000 * (32 * 3 + 48), "the torus's triangles are kept once");
+        assert!(
+            few > 10_000 * (32 * 3 + 48),
+            "the torus's triangles are kept once"
+        );
     }
 
     #[test]

@@ -10,11 +10,11 @@ use glam::Vec3;
 use pathlight_scene::{Light, LightKind};
 
 use crate::geometry::Geometry;
-use crate::instance::world_triangle;
 use crate::gpu_types::{
-    FLAG_CAPS, GpuInstance, GpuLight, GpuObject, GpuVertex, KIND_CYLINDER, KIND_MESH, KIND_QUAD, KIND_SPHERE,
-    LIGHT_AREA, LIGHT_POINT, LIGHT_SUN, NO_LIGHT,
+    FLAG_CAPS, GpuInstance, GpuLight, GpuObject, GpuVertex, KIND_CYLINDER, KIND_MESH, KIND_QUAD,
+    KIND_SPHERE, LIGHT_AREA, LIGHT_POINT, LIGHT_SUN, NO_LIGHT,
 };
+use crate::instance::world_triangle;
 
 /// Luminance of linear RGB (Rec. 709 weights): what emitters and environment-map cells are
 /// chosen by.
@@ -93,7 +93,10 @@ pub fn build(
         };
         object.light = table.len() as u32;
         for primitive in primitives {
-            powers.push(emitter_area(object, &geometry.vertices, &geometry.instances, primitive) * luminance);
+            powers.push(
+                emitter_area(object, &geometry.vertices, &geometry.instances, primitive)
+                    * luminance,
+            );
             table.push(GpuLight {
                 kind: LIGHT_AREA,
                 index: i as u32,

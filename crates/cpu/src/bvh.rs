@@ -98,6 +98,25 @@ impl RayLanes {
         }
         (t_near, t_near.cmple(t_far * ROBUST_FAR).bitmask())
     }
+
+    /// Whether the ray enters the box from `lo` to `hi` before `t_max`: the slab test of
+    /// [`Self::enter`] on one box. Twin of WGSL `enters_box`.
+    #[inline(always)]
+    fn enters_box(&self, lo: Vec3, hi: Vec3, t_max: f32) -> bool {
+        let mut t_near = 0.0f32;
+        let mut t_far = t_max;
+        for axis in 0..3 {
+            let (near, far) = if self.backwards[axis] {
+                (hi[axis], lo[axis])
+            } else {
+                (lo[axis], hi[axis])
+            };
+            let (o, inv) = (self.origin[axis].x, self.inv_dir[axis].x);
+            t_near = t_near.max((near - o) * inv);
+            t_far = t_far.min((far - o) * inv);
+        }
+        t_near <= t_far * ROBUST_FAR
+    }
 }
 
 impl CpuScene<'_> {
@@ -192,7 +211,7 @@ pub(crate) fn trace_scene(
             any_hit,
             object: TOP_LEVEL,
         };
-        walk.tree(stack, 0, &mut hit);
+        walk.tree::<true>(stack, 0, &mut hit);
     }
     hit
 }
@@ -211,12 +230,12 @@ pub(crate) struct Walk<'a> {
 }
 
 impl Walk<'_> {
-    /// Tests primitive `i` of a leaf: a shape or a triangle, or in the top level an
+    /// Tests primitive `i` of a leaf: a shape or a triangle, or in the top level (`TOP`) an
     /// instance, whose mesh's tree the ray then walks (on `stack`, above its entries).
     #[inline(always)]
-    fn primitive(&self, stack: &mut Vec<Entry>, i: u32, hit: &mut Hit) {
+    fn primitive<const TOP: bool>(&self, stack: &mut Vec<Entry>, i: u32, hit: &mut Hit) {
         let p = &self.scene.primitives[i as usize];
-        if self.object != TOP_LEVEL {
+        if !TOP {
             self.scene.hit_triangle(self.object, p, &self.sheared, hit);
         } else if p.triangle == INSTANCE {
             self.instance(stack, p, hit);
@@ -227,10 +246,17 @@ impl Walk<'_> {
     }
 
     /// The ray walks the tree of the instance `p` places, in its mesh's space (the same
-    /// distances: the direction is not renormalised). Twin of WGSL `trace_instance`.
-    #[inline(never)]
+    /// distances: the direction is not renormalised). Inlined like the rest of the walk, so
+    /// that it is compiled for the row renderer's instruction set. Twin of WGSL
+    /// `trace_instance`.
+    #[inline(always)]
     pub(crate) fn instance(&self, stack: &mut Vec<Entry>, p: &GpuPrimitive, hit: &mut Hit) {
         let object = &self.scene.objects[p.object as usize];
+        // Its world box first: a leaf may hold several placements.
+        let (lo, hi) = (Vec3::from_slice(&object.a), Vec3::from_slice(&object.b));
+        if !self.lanes.enters_box(lo, hi, hit.t) {
+            return;
+        }
         let instance = &self.scene.instances[object.instance as usize];
         let ray = Ray::new(
             instance.to_object_point(self.ray.origin.into()),
@@ -245,14 +271,15 @@ impl Walk<'_> {
             any_hit: self.any_hit,
             object: p.object,
         };
-        walk.tree(stack, p.root, hit);
+        walk.tree::<false>(stack, p.root, hit);
     }
 
     /// Walks the subtree at `root`, nearest boxes first, using `stack` above its
-    /// current length. A node's entered leaves are tested as it is visited (nearest first);
-    /// inner nodes are pushed. An any-hit query stops at its first hit.
+    /// current length: of the top-level tree with `TOP`, else of a shared mesh's (whose
+    /// leaves hold triangles alone). A node's entered leaves are tested as it is visited
+    /// (nearest first); inner nodes are pushed. An any-hit query stops at its first hit.
     #[inline(always)]
-    pub(crate) fn tree(&self, stack: &mut Vec<Entry>, root: u32, hit: &mut Hit) {
+    pub(crate) fn tree<const TOP: bool>(&self, stack: &mut Vec<Entry>, root: u32, hit: &mut Hit) {
         let base = stack.len();
         let mut node = root;
         loop {
@@ -277,7 +304,7 @@ impl Walk<'_> {
                 let count = n.count[lane] & !SHAPE_LEAF;
                 if count > 0 && t < hit.t {
                     for i in n.first[lane]..n.first[lane] + count {
-                        self.primitive(stack, i, hit);
+                        self.primitive::<TOP>(stack, i, hit);
                     }
                     if self.any_hit && hit.object != u32::MAX {
                         return;
@@ -454,7 +481,11 @@ pub(crate) mod tests {
     /// scene with its instances flattened).
     fn assert_walk(scene: &CpuScene, truth: &CpuScene, rays: &[Ray]) -> usize {
         let tracer = std::cell::RefCell::new(Tracer::new(scene));
-        let tolerance = if std::ptr::eq(scene, truth) { 1e-5 } else { 1e-4 };
+        let tolerance = if std::ptr::eq(scene, truth) {
+            1e-5
+        } else {
+            1e-4
+        };
         assert_like_brute_force(
             truth,
             tolerance,
@@ -491,7 +522,11 @@ pub(crate) mod tests {
     pub(crate) fn instanced_objects(rng: &mut StdRng) -> Vec<Object> {
         let mut objects = random_objects(rng, 12);
         let rocks = random_placements(rng, 30);
-        objects.extend(instances_of("rocks", random_mesh(rng, 200, Vec3::ZERO), &rocks));
+        objects.extend(instances_of(
+            "rocks",
+            random_mesh(rng, 200, Vec3::ZERO),
+            &rocks,
+        ));
         let balls = random_placements(rng, 12);
         objects.extend(instances_of("balls", icosphere(2), &balls));
         objects
@@ -518,7 +553,10 @@ pub(crate) mod tests {
             })
             .sum();
         assert_eq!(prepared.geometry.triangle_count(), world + 200 + 320);
-        assert_eq!(prepared.geometry.placed_triangle_count(), flat.geometry.triangle_count());
+        assert_eq!(
+            prepared.geometry.placed_triangle_count(),
+            flat.geometry.triangle_count()
+        );
     }
 
     #[test]

@@ -5,8 +5,8 @@
 use glam::{Vec3, Vec3A};
 use pathlight_core::PreparedScene;
 use pathlight_core::gpu_types::{
-    GpuInstance, GpuLight, GpuMaterial, GpuObject, GpuPrimitive, GpuTextureSlot, GpuVertex, GpuWideNode,
-    KIND_QUAD,
+    GpuInstance, GpuLight, GpuMaterial, GpuObject, GpuPrimitive, GpuTextureSlot, GpuVertex,
+    GpuWideNode, KIND_QUAD,
 };
 
 /// A view of a [`PreparedScene`] with the buffers of bind group 0 (`scene.wgsl`) side by

@@ -479,28 +479,24 @@ impl PacketWalk<'_> {
     /// Ray `lane` walks the subtree at `node` alone.
     #[inline(always)]
     fn alone(&self, stacks: &mut Stacks, lane: usize, node: u32, hits: &mut PacketHits) {
-        self.each_alone(stacks, 1 << lane, hits, |walk, stack, hit| {
-            walk.tree(stack, node, hit)
-        });
+        self.each_alone(stacks, 1 << lane, hits, Alone::Subtree(node));
     }
 
     /// The rays `lanes` walk the tree of the instance `p` places, one by one.
-    #[inline(never)]
+    #[inline(always)]
     fn instance(&self, stacks: &mut Stacks, p: &GpuPrimitive, lanes: Lanes, hits: &mut PacketHits) {
-        self.each_alone(stacks, lanes, hits, |walk, stack, hit| {
-            walk.instance(stack, p, hit)
-        });
+        self.each_alone(stacks, lanes, hits, Alone::Instance(p));
     }
 
-    /// Each ray of `lanes` in turn, with its current hit, given to `walk` as a single-ray
-    /// walk of the top level (the single-ray stack emptied first).
+    /// Each ray of `lanes` in turn, with its current hit, walks `what` as a single ray (the
+    /// single-ray stack emptied first).
     #[inline(always)]
     fn each_alone(
         &self,
         stacks: &mut Stacks,
         mut lanes: Lanes,
         hits: &mut PacketHits,
-        walk: impl Fn(&Walk, &mut Vec<Entry>, &mut Hit),
+        what: Alone,
     ) {
         while lanes != 0 {
             let lane = lanes.trailing_zeros() as usize;
@@ -517,13 +513,23 @@ impl PacketWalk<'_> {
             };
             let mut hit = hits.get(lane);
             stacks.single.clear();
-            walk(&single, stacks.single, &mut hit);
+            match what {
+                Alone::Subtree(node) => single.tree::<true>(stacks.single, node, &mut hit),
+                Alone::Instance(p) => single.instance(stacks.single, p, &mut hit),
+            }
             hits.set(lane, hit);
             if self.any_hit && hit.object != u32::MAX {
                 hits.searching &= !(1 << lane);
             }
         }
     }
+}
+
+/// What a ray of a packet walks alone: a subtree of the top level, or a placed instance.
+#[derive(Clone, Copy)]
+enum Alone<'a> {
+    Subtree(u32),
+    Instance(&'a GpuPrimitive),
 }
 
 #[cfg(test)]
@@ -540,10 +546,10 @@ mod tests {
     use crate::bvh::tests::{
         assert_like_brute_force, instanced_objects, prepare, random_ray, ray_into_scene,
     };
-    use pathlight_scene::testing::flattened;
     use crate::cpu_scene::CpuScene;
     use crate::intersect::Ray;
     use crate::tracer::Tracer;
+    use pathlight_scene::testing::flattened;
 
     /// Each ray traced in a packet with others of `rays`, at a lane that depends on the ray,
     /// gets brute force's answer. Every other packet holds the ray alone (it walks alone from
@@ -575,7 +581,11 @@ mod tests {
             }
             (packet, lane)
         };
-        let tolerance = if std::ptr::eq(scene, truth) { 1e-5 } else { 1e-4 };
+        let tolerance = if std::ptr::eq(scene, truth) {
+            1e-5
+        } else {
+            1e-4
+        };
         assert_like_brute_force(
             truth,
             tolerance,

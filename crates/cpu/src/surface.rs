@@ -5,8 +5,8 @@ use std::f32::consts::{PI, TAU};
 
 use glam::{Vec2, Vec3A};
 use pathlight_core::gpu_types::{
-    FLAG_CAPS, FLAG_FLAT, FLAG_INSTANCE, FLAG_MIRRORED, GpuMaterial, KIND_CYLINDER, KIND_QUAD, KIND_SPHERE, TEXTURE_COAT_NORMAL,
-    TEXTURE_NORMAL,
+    FLAG_CAPS, FLAG_FLAT, FLAG_INSTANCE, FLAG_MIRRORED, GpuMaterial, KIND_CYLINDER, KIND_QUAD,
+    KIND_SPHERE, TEXTURE_COAT_NORMAL, TEXTURE_NORMAL,
 };
 use pathlight_core::octahedral::{self, tangent_sign};
 
@@ -151,13 +151,19 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
             let [v0, v1, v2] = [0, 1, 2].map(|k| scene.vertices[i + k]);
             let b0 = 1.0 - hit.b1 - hit.b2;
             let [p0, p1, p2] = [v0, v1, v2].map(|v| Vec3A::from(v.position));
-            let instance = (o.flags & FLAG_INSTANCE != 0).then(|| &scene.instances[o.instance as usize]);
+            let instance =
+                (o.flags & FLAG_INSTANCE != 0).then(|| &scene.instances[o.instance as usize]);
             let ng = (p1 - p0).cross(p2 - p0);
             s.ng = instance.map_or(ng, |i| i.to_world_normal(ng)).normalize();
+            // An instance's corner normals and tangents are placed one by one, as a glTF
+            // viewer's vertex shader places them (and as the mesh flattened holds them).
             let decode = |code: u32| Vec3A::from(octahedral::decode(code));
+            let normal = |code: u32| match instance {
+                Some(i) => i.to_world_normal(decode(code)).normalize_or_zero(),
+                None => decode(code),
+            };
             let n =
-                b0 * decode(v0.normal) + hit.b1 * decode(v1.normal) + hit.b2 * decode(v2.normal);
-            let n = instance.map_or(n, |i| i.to_world_normal(n));
+                b0 * normal(v0.normal) + hit.b1 * normal(v1.normal) + hit.b2 * normal(v2.normal);
             s.uv = b0 * Vec2::from(v0.uv) + hit.b1 * Vec2::from(v1.uv) + hit.b2 * Vec2::from(v2.uv);
             s.color = triangle_color(scene, hit.primitive, hit.b1, hit.b2)
                 .truncate()
@@ -171,16 +177,18 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
             let interpolated = s.ns;
             let wo = -Vec3A::from(ray.dir);
             let side = if wo.dot(s.ng) >= 0.0 { 1.0 } else { -1.0 };
-            let tangent = if m.texture_mask & ((1 << TEXTURE_NORMAL) | (1 << TEXTURE_COAT_NORMAL))
-                != 0
-            {
-                let t = b0 * decode(v0.tangent)
-                    + hit.b1 * decode(v1.tangent)
-                    + hit.b2 * decode(v2.tangent);
-                instance.map_or(t, |i| i.to_world_vector(t))
-            } else {
-                Vec3A::ZERO
-            };
+            let tangent =
+                if m.texture_mask & ((1 << TEXTURE_NORMAL) | (1 << TEXTURE_COAT_NORMAL)) != 0 {
+                    let tangent = |code: u32| match instance {
+                        Some(i) => i.to_world_vector(decode(code)).normalize_or_zero(),
+                        None => decode(code),
+                    };
+                    b0 * tangent(v0.tangent)
+                        + hit.b1 * tangent(v1.tangent)
+                        + hit.b2 * tangent(v2.tangent)
+                } else {
+                    Vec3A::ZERO
+                };
             let mirrored = o.flags & FLAG_MIRRORED != 0;
             let sign = tangent_sign(v0.tangent) * if mirrored { -1.0 } else { 1.0 };
             if has_texture(m, TEXTURE_NORMAL) {

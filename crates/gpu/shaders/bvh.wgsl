@@ -96,12 +96,13 @@ fn intersect_primitive(i: u32, ray: Ray, sheared: ShearedRay, hit: ptr<function,
     hit_triangle(p.object, p.triangle, p.v0, p.v1, p.v2, sheared, hit);
 }
 
-// Primitive `i` of a top-level shape leaf: an instance is walked (`trace_instance`), a shape
-// or a triangle tested.
-fn intersect_top_level(i: u32, ray: Ray, sheared: ShearedRay, any_hit: bool, hit: ptr<function, Hit>) {
+// Primitive `i` of a top-level shape leaf: an instance is walked (`trace_instance`, on
+// `stack` above its `sp` entries), a shape or a triangle tested; `inv_dir` and `backwards` are
+// the ray's as `enter_children` takes them.
+fn intersect_top_level(i: u32, ray: Ray, sheared: ShearedRay, inv_dir: vec3f, backwards: vec3<bool>, any_hit: bool, stack: ptr<function, array<vec2u, STACK_SIZE>>, sp: u32, hit: ptr<function, Hit>) {
     let p = primitives[i];
-    if p.triangle == INSTANCE {
-        trace_instance(p, ray, any_hit, hit);
+    if INSTANCES && p.triangle == INSTANCE {
+        trace_instance(p, ray, inv_dir, backwards, any_hit, stack, sp, hit);
     } else {
         intersect_primitive(i, ray, sheared, hit);
     }
@@ -118,12 +119,30 @@ fn intersect_triangles(first: u32, count: u32, object: u32, ray: ShearedRay, hit
 
 // The walk through the tree of the instance that primitive `p` places, in its mesh's space:
 // the ray moved by the instance's `to_object` (its direction not renormalised, so distances
-// stay), the hits the instance object's.
+// stay), the hits the instance object's. It walks on `stack` above its `sp` entries, or
+// without a stack when `stack` is null... A leaf may hold several placements: each one's
+// world box is tested first.
 // CPU twin: `Walk::instance`.
-fn trace_instance(p: Primitive, ray: Ray, any_hit: bool, hit: ptr<function, Hit>) {
-    let m = instances[objects[p.object].instance];
+fn trace_instance(p: Primitive, ray: Ray, inv_dir: vec3f, backwards: vec3<bool>, any_hit: bool, stack: ptr<function, array<vec2u, STACK_SIZE>>, sp: u32, hit: ptr<function, Hit>) {
+    let o = objects[p.object];
+    if !enters_box(o.a.xyz, o.b.xyz, ray.origin, inv_dir, backwards, (*hit).t) {
+        return;
+    }
+    let m = instances[o.instance];
     let local = Ray(to_object_point(m, ray.origin), to_object_vector(m, ray.dir));
-    trace_mesh(p.root, p.object, local, any_hit, hit);
+    trace_mesh(p.root, p.object, local, any_hit, stack, sp, hit);
+}
+
+// `trace_instance` for the walk without a stack (`trace_stackless`).
+fn trace_instance_stackless(p: Primitive, ray: Ray, inv_dir: vec3f, backwards: vec3<bool>, any_hit: bool, hit: ptr<function, Hit>) {
+    let o = objects[p.object];
+    if !enters_box(o.a.xyz, o.b.xyz, ray.origin, inv_dir, backwards, (*hit).t) {
+        return;
+    }
+    let m = instances[o.instance];
+    let local = Ray(to_object_point(m, ray.origin), to_object_vector(m, ray.dir));
+    let local_inv = safe_inverse(local.dir);
+    trace_mesh_stackless(p.root, p.object, local, sheared_ray(local), local_inv, local_inv < vec3f(0.0), any_hit, hit);
 }
 
 // Nearest hit among the triangles of mesh object `i`, read from `vertices`.
@@ -144,7 +163,7 @@ fn intersect_linear(ray: Ray, sheared: ShearedRay, inv_dir: vec3f, object_count:
             intersect_shape(i, o, ray, hit);
         } else if ACCEL == ACCEL_BRUTE_FORCE
             || intersect_aabb(Aabb(o.a.xyz, o.b.xyz), ray.origin, inv_dir, (*hit).t) != MISS {
-            if (o.flags & FLAG_INSTANCE) != 0u {
+            if INSTANCES && (o.flags & FLAG_INSTANCE) != 0u {
                 let m = instances[o.instance];
                 let local = Ray(to_object_point(m, ray.origin), to_object_vector(m, ray.dir));
                 intersect_mesh(i, o, sheared_ray(local), hit);
@@ -172,6 +191,17 @@ fn enter_children(n: WideNode, origin: vec3f, inv_dir: vec3f, backwards: vec3<bo
     let t_near = max(max(near_x, near_y), max(near_z, vec4f(0.0)));
     let t_far = min(min(far_x, far_y), min(far_z, vec4f(t_max)));
     return select(vec4f(MISS), t_near, t_near <= t_far * ROBUST_FAR);
+}
+
+// Whether the ray enters the box from `lo` to `hi` before `t_max`: `enter_children`'s slab
+// test on one box.
+// CPU twin: `RayLanes::enters_box`.
+fn enters_box(lo: vec3f, hi: vec3f, origin: vec3f, inv_dir: vec3f, backwards: vec3<bool>, t_max: f32) -> bool {
+    let near = (select(lo, hi, backwards) - origin) * inv_dir;
+    let far = (select(hi, lo, backwards) - origin) * inv_dir;
+    let t_near = max(max(near.x, near.y), max(near.z, 0.0));
+    let t_far = min(min(far.x, far.y), min(far.z, t_max));
+    return t_near <= t_far * ROBUST_FAR;
 }
 
 // Orders the pairs (a, b) by key: afterwards *ka <= *kb.
@@ -217,7 +247,7 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
                 let first = n.first[lane];
                 let end = first + (n.count[lane] & ~SHAPE_LEAF);
                 for (var i = first; i < end; i++) {
-                    intersect_top_level(i, ray, sheared, any_hit, &hit);
+                    intersect_top_level(i, ray, sheared, inv_dir, backwards, any_hit, &stack, sp, &hit);
                 }
             }
             if any_hit && hit.object != NO_HIT {
@@ -227,14 +257,44 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
         // The other children still to visit (inner nodes, and leaves of triangles as LEAF
         // entries), sorted by entry distance: the nearest is taken next, the others are
         // pushed, farthest first.
-        let o = order_children(n, index, t, t < vec4f(hit.t) & !at_once);
-        let pushes = u32(o.keys.y != MISS) + u32(o.keys.z != MISS) + u32(o.keys.w != MISS);
+        let leaves = vec4u(LEAF | (index << 2u)) | vec4u(0u, 1u, 2u, 3u);
+        let entries = select(n.first, leaves, n.count != vec4u(0u));
+        let take = t < vec4f(hit.t) & !at_once;
+        var k0 = select(MISS, t.x, take.x);
+        var k1 = select(MISS, t.y, take.y);
+        var k2 = select(MISS, t.z, take.z);
+        var k3 = select(MISS, t.w, take.w);
+        var c0 = entries.x;
+        var c1 = entries.y;
+        var c2 = entries.z;
+        var c3 = entries.w;
+        order_pair(&k0, &c0, &k1, &c1);
+        order_pair(&k2, &c2, &k3, &c3);
+        order_pair(&k0, &c0, &k2, &c2);
+        order_pair(&k1, &c1, &k3, &c3);
+        order_pair(&k1, &c1, &k2, &c2);
+        let pushes = u32(k1 != MISS) + u32(k2 != MISS) + u32(k3 != MISS);
         if sp + pushes > STACK_SIZE {
             // Deeper than the stack: walk again from the root without one, keeping the hit.
             trace_stackless(ray, sheared, inv_dir, backwards, any_hit, &hit);
             return hit;
         }
-        let next = push_children(&stack, &sp, o, hit.t);
+        if k3 != MISS {
+            stack[sp] = vec2u(c3, bitcast<u32>(k3));
+            sp++;
+        }
+        if k2 != MISS {
+            stack[sp] = vec2u(c2, bitcast<u32>(k2));
+            sp++;
+        }
+        if k1 != MISS {
+            stack[sp] = vec2u(c1, bitcast<u32>(k1));
+            sp++;
+        }
+        var next = c0;
+        if k0 == MISS {
+            next = pop_entry(&stack, &sp, 0u, hit.t);
+        }
         // Leaves of triangles, nearest first, until the next inner node ("while-while", Aila
         // and Laine: a warp's lanes intersect triangles together, then walk nodes together).
         var entry = next;
@@ -251,7 +311,7 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
             if any_hit && hit.object != NO_HIT {
                 return hit;
             }
-            entry = pop_entry(&stack, &sp, hit.t);
+            entry = pop_entry(&stack, &sp, 0u, hit.t);
         }
         index = entry;
     }
@@ -286,9 +346,9 @@ fn order_children(n: WideNode, index: u32, t: vec4f, take: vec4<bool>) -> Ordere
 }
 
 // Pushes the sorted children `o` but the nearest (which the caller has room for), farthest
-// first, and returns the next entry to visit: the nearest child, else the next popped one
-// nearer than `t` (NO_NODE when none is left).
-fn push_children(stack: ptr<function, array<vec2u, STACK_SIZE>>, sp: ptr<function, u32>, o: OrderedChildren, t: f32) -> u32 {
+// first, and returns the next entry to visit: the nearest child, else the next one popped
+// above `base` nearer than `t` (NO_NODE when none is left).
+fn push_children(stack: ptr<function, array<vec2u, STACK_SIZE>>, sp: ptr<function, u32>, base: u32, o: OrderedChildren, t: f32) -> u32 {
     for (var k = 3; k >= 1; k--) {
         if o.keys[k] != MISS {
             (*stack)[*sp] = vec2u(o.entries[k], bitcast<u32>(o.keys[k]));
@@ -296,20 +356,20 @@ fn push_children(stack: ptr<function, array<vec2u, STACK_SIZE>>, sp: ptr<functio
         }
     }
     if o.keys.x == MISS {
-        return pop_entry(stack, sp, t);
+        return pop_entry(stack, sp, base, t);
     }
     return o.entries.x;
 }
 
 // Nearest hit (or with `any_hit` the first) among the triangles of the shared mesh's tree at
 // `root`, as parts of instance object `object`, updating `hit`: `trace_scene`'s walk without
-// shapes, on a stack of its own (the host sizes it for the meshes' trees too).
-fn trace_mesh(root: u32, object: u32, ray: Ray, any_hit: bool, hit: ptr<function, Hit>) {
+// shapes, on `stack` above its `base` entries (the host sizes the stack for a top-level walk
+// and a mesh's together; deeper, it walks the mesh without a stack).
+fn trace_mesh(root: u32, object: u32, ray: Ray, any_hit: bool, stack: ptr<function, array<vec2u, STACK_SIZE>>, base: u32, hit: ptr<function, Hit>) {
     let inv_dir = safe_inverse(ray.dir);
     let sheared = sheared_ray(ray);
     let backwards = inv_dir < vec3f(0.0);
-    var stack: array<vec2u, STACK_SIZE>;
-    var sp = 0u;
+    var sp = base;
     var index = root;
     loop {
         let n = nodes[index];
@@ -320,7 +380,7 @@ fn trace_mesh(root: u32, object: u32, ray: Ray, any_hit: bool, hit: ptr<function
             trace_mesh_stackless(root, object, ray, sheared, inv_dir, backwards, any_hit, hit);
             return;
         }
-        var entry = push_children(&stack, &sp, o, (*hit).t);
+        var entry = push_children(stack, &sp, base, o, (*hit).t);
         loop {
             if entry == NO_NODE {
                 return;
@@ -334,7 +394,7 @@ fn trace_mesh(root: u32, object: u32, ray: Ray, any_hit: bool, hit: ptr<function
             if any_hit && (*hit).object != NO_HIT {
                 return;
             }
-            entry = pop_entry(&stack, &sp, (*hit).t);
+            entry = pop_entry(stack, &sp, base, (*hit).t);
         }
         index = entry;
     }
@@ -402,7 +462,12 @@ fn trace_stackless(ray: Ray, sheared: ShearedRay, inv_dir: vec3f, backwards: vec
                 let first = n.first[lane];
                 let end = first + (n.count[lane] & ~SHAPE_LEAF);
                 for (var i = first; i < end; i++) {
-                    intersect_top_level(i, ray, sheared, any_hit, hit);
+                    let p = primitives[i];
+                    if INSTANCES && p.triangle == INSTANCE {
+                        trace_instance_stackless(p, ray, inv_dir, backwards, any_hit, hit);
+                    } else {
+                        intersect_primitive(i, ray, sheared, hit);
+                    }
                 }
             }
             if any_hit && (*hit).object != NO_HIT {
@@ -422,10 +487,10 @@ fn trace_stackless(ray: Ray, sheared: ShearedRay, inv_dir: vec3f, backwards: vec
     }
 }
 
-// Pops the next entry whose subtree may hold a hit nearer than `t` and returns it (an inner
-// node or a LEAF entry), or NO_NODE when none is left.
-fn pop_entry(stack: ptr<function, array<vec2u, STACK_SIZE>>, sp: ptr<function, u32>, t: f32) -> u32 {
-    while *sp > 0u {
+// Pops the next entry above `base` whose subtree may hold a hit nearer than `t` and returns
+// it (an inner node or a LEAF entry), or NO_NODE when none is left.
+fn pop_entry(stack: ptr<function, array<vec2u, STACK_SIZE>>, sp: ptr<function, u32>, base: u32, t: f32) -> u32 {
+    while *sp > base {
         *sp -= 1u;
         let top = (*stack)[*sp];
         if bitcast<f32>(top.y) < t {

@@ -41,11 +41,17 @@ fn to_world_normal(m: Instance, n: vec3f) -> vec3f {
 fn world_triangle(o: Object, triangle: u32) -> array<vec3f, 3> {
     let i = 3u * triangle;
     var corners = array<vec3f, 3>(vertices[i].position, vertices[i + 1u].position, vertices[i + 2u].position);
-    if (o.flags & FLAG_INSTANCE) != 0u {
+    if INSTANCES && (o.flags & FLAG_INSTANCE) != 0u {
         let m = instances[o.instance];
         for (var k = 0u; k < 3u; k++) {
             corners[k] = to_world_point(m, corners[k]);
         }
     }
     return corners;
+}
+
+// `v` made unit, or zero when it has no length (a corner without a normal or tangent).
+fn normalize_or_zero(v: vec3f) -> vec3f {
+    let l = length(v);
+    return select(vec3f(0.0), v / l, l > 0.0);
 }

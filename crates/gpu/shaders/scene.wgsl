@@ -92,6 +92,11 @@ struct Primitive {
 const NO_TRIANGLE: u32 = 0xffffffffu;
 const INSTANCE: u32 = 0xfffffffeu;
 
+// Whether the scene places instances (a pipeline constant): false compiles the instance paths
+// out, which costs a scene without any nothing (on lavapipe the walk's nested mesh walk alone
+// halved the default scene's samples/s).
+override INSTANCES: bool = true;
+
 // The placement of an instance: rows of its affine transforms, each (x, y, z, translation).
 struct Instance {
     to_object: array<vec4f, 3>,

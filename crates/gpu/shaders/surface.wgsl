@@ -126,14 +126,20 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
             let v1 = vertices[i + 1u];
             let v2 = vertices[i + 2u];
             let b0 = 1.0 - hit.b1 - hit.b2;
-            let instanced = (o.flags & FLAG_INSTANCE) != 0u;
+            let instanced = INSTANCES && (o.flags & FLAG_INSTANCE) != 0u;
             var ng = cross(v1.position - v0.position, v2.position - v0.position);
-            var n = b0 * decode_unit(v0.normal) + hit.b1 * decode_unit(v1.normal) + hit.b2 * decode_unit(v2.normal);
+            var n0 = decode_unit(v0.normal);
+            var n1 = decode_unit(v1.normal);
+            var n2 = decode_unit(v2.normal);
             if instanced {
+                // Corner by corner, as a glTF viewer's vertex shader places them.
                 let placement = instances[o.instance];
                 ng = to_world_normal(placement, ng);
-                n = to_world_normal(placement, n);
+                n0 = normalize_or_zero(to_world_normal(placement, n0));
+                n1 = normalize_or_zero(to_world_normal(placement, n1));
+                n2 = normalize_or_zero(to_world_normal(placement, n2));
             }
+            let n = b0 * n0 + hit.b1 * n1 + hit.b2 * n2;
             s.ng = normalize(ng);
             s.uv = b0 * v0.uv + hit.b1 * v1.uv + hit.b2 * v2.uv;
             s.color = triangle_color(hit.primitive, hit.b1, hit.b2).rgb;
@@ -148,10 +154,16 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
             let wo = -ray.dir;
             let side = select(-1.0, 1.0, dot(wo, s.ng) >= 0.0);
             if (m.texture_mask & ((1u << TEXTURE_NORMAL) | (1u << TEXTURE_COAT_NORMAL))) != 0u {
-                tangent = b0 * decode_unit(v0.tangent) + hit.b1 * decode_unit(v1.tangent) + hit.b2 * decode_unit(v2.tangent);
+                var t0 = decode_unit(v0.tangent);
+                var t1 = decode_unit(v1.tangent);
+                var t2 = decode_unit(v2.tangent);
                 if instanced {
-                    tangent = to_world_vector(instances[o.instance], tangent);
+                    let placement = instances[o.instance];
+                    t0 = normalize_or_zero(to_world_vector(placement, t0));
+                    t1 = normalize_or_zero(to_world_vector(placement, t1));
+                    t2 = normalize_or_zero(to_world_vector(placement, t2));
                 }
+                tangent = b0 * t0 + hit.b1 * t1 + hit.b2 * t2;
             }
             let sign = tangent_sign(v0.tangent) * select(1.0, -1.0, (o.flags & FLAG_MIRRORED) != 0u);
             if has_texture(m, TEXTURE_NORMAL) {

@@ -130,6 +130,7 @@ impl GpuRenderer {
             &frame_layout,
             accel,
             stack_size,
+            scene.geometry.has_instances(),
         )?;
         let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("render params"),
@@ -524,14 +525,21 @@ fn frame_bind_group(
     bind_buffers(device, "frame", layout, &[params, accum, counters, aovs])
 }
 
-/// The integrator pipeline with the given scheme and traversal stack.
+/// The integrator pipeline with the given scheme and traversal stack, its instance paths
+/// compiled in when the scene has `instances` (the `INSTANCES` constant of `scene.wgsl`).
 fn integrator_pipeline(
     device: &wgpu::Device,
     scene_layout: &wgpu::BindGroupLayout,
     frame_layout: &wgpu::BindGroupLayout,
     accel: Accel,
     stack_size: u32,
+    instances: bool,
 ) -> Result<wgpu::ComputePipeline, RenderError> {
+    let [accel_constant] = accel.pipeline_constants();
+    let constants = [
+        accel_constant,
+        ("INSTANCES", f64::from(u8::from(instances))),
+    ];
     create_compute_pipeline(
         device,
         "integrator",
@@ -543,6 +551,6 @@ fn integrator_pipeline(
         })?,
         "render",
         &[scene_layout, frame_layout],
-        &accel.pipeline_constants(),
+        &constants,
     )
 }

@@ -7,8 +7,8 @@ use std::mem::{offset_of, size_of};
 
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use pathlight_core::gpu_types::{
-    GpuAccumPixel, GpuCamera, GpuInstance, GpuLight, GpuMaterial, GpuObject, GpuPrimitive, GpuRenderParams,
-    GpuTextureSlot, GpuVertex, GpuWideNode,
+    GpuAccumPixel, GpuCamera, GpuInstance, GpuLight, GpuMaterial, GpuObject, GpuPrimitive,
+    GpuRenderParams, GpuTextureSlot, GpuVertex, GpuWideNode,
 };
 use pathlight_gpu::display::GpuDisplayParams;
 use pathlight_gpu::wgsl::{self, AssemblyError};

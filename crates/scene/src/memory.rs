@@ -206,7 +206,11 @@ mod tests {
             triangles,
             instances: 0,
         };
-        assert!(budget.check(triangles((1 << 30) / BYTES_PER_TRIANGLE)).is_ok());
+        assert!(
+            budget
+                .check(triangles((1 << 30) / BYTES_PER_TRIANGLE))
+                .is_ok()
+        );
         let message = budget.check(triangles(10_000_000)).unwrap_err();
         assert_eq!(
             message,

@@ -91,7 +91,8 @@ impl Instance {
         let (min, max) = self.mesh.bounds();
         (0..8)
             .map(|corner| {
-                let pick = |bit: u32, lo: f32, hi: f32| if corner >> bit & 1 == 0 { lo } else { hi };
+                let pick =
+                    |bit: u32, lo: f32, hi: f32| if corner >> bit & 1 == 0 { lo } else { hi };
                 let p = Vec3::new(
                     pick(0, min.x, max.x),
                     pick(1, min.y, max.y),
@@ -108,7 +109,9 @@ impl TriangleMesh {
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.positions
             .iter()
-            .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+            .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), &p| {
+                (lo.min(p), hi.max(p))
+            })
     }
 }
 

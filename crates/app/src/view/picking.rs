@@ -197,4 +197,40 @@ mod tests {
             "{e}"
         );
     }
+
+    /// Clicking one placement of a shared mesh picks that placement, and lighting it makes
+    /// it alone a light: the other placements of the mesh stay as they were.
+    #[test]
+    fn picking_an_instance_lights_that_placement_alone() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/instances.toml");
+        let mut scene = pathlight_scene::load_scene_file(&path).unwrap();
+        let prepared = PreparedScene::new(&scene).unwrap();
+        let gold = index_of(&scene, "gold gem");
+        let (x, y) = project(&scene, Vec3::new(-0.45, -0.55, -0.45));
+        let picked = pick(&scene, &prepared, x, y).map(|p| p.object);
+        assert_eq!(picked, Some(gold), "at ({x}, {y})");
+        let mut switch = LightSwitch::new(&scene, Some(3.0));
+        assert!(switch.toggle(&mut scene, gold));
+        let shading = prepared.shading_of(&scene);
+        let lit: std::collections::BTreeSet<u32> = shading
+            .lights
+            .iter()
+            .filter(|l| l.kind == pathlight_core::gpu_types::LIGHT_AREA)
+            .map(|l| l.index)
+            .collect();
+        let names: Vec<&str> = lit
+            .iter()
+            .map(|&i| scene.objects[i as usize].name.as_str())
+            .collect();
+        assert_eq!(names, ["light", "gold gem", "lantern"]);
+        let entries = |object: usize| {
+            shading
+                .lights
+                .iter()
+                .filter(|l| l.index == object as u32)
+                .count()
+        };
+        assert_eq!(entries(gold), 8, "one entry per triangle of the placement");
+    }
 }

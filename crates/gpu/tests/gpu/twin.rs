@@ -23,6 +23,7 @@ fn gpu_and_cpu_render_the_same_image() {
         ("refs/cornell-dof.toml", 1e-3),
         ("default.toml", 1e-3),
         ("refs/lights.toml", 1e-3),
+        ("instances.toml", 1e-3),
         ("soft lights", 1e-3),
     ] {
         let s = if name == "soft lights" {

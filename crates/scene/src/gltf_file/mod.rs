@@ -22,8 +22,8 @@ use crate::error::SceneError;
 use crate::memory::SceneSize;
 use crate::settings::MAX_COORDINATE;
 use crate::{
-    Camera, Cone, Environment, Instance, Light, LightKind, Material, Object, RenderSettings,
-    Scene, Shape, Texture, TriangleMesh,
+    Camera, Cone, Environment, Instance, Light, LightKind, Material, Object, RenderSettings, Scene,
+    Shape, Texture, TriangleMesh,
 };
 use data::Files;
 use materials::Materials;

@@ -140,7 +140,10 @@ impl Builder<'_, '_> {
                     to_world,
                 };
                 let (min, max) = instance.bounds();
-                if !(min.abs().max(max.abs())).cmple(Vec3::splat(MAX_COORDINATE)).all() {
+                if !(min.abs().max(max.abs()))
+                    .cmple(Vec3::splat(MAX_COORDINATE))
+                    .all()
+                {
                     let what = if k == 0 {
                         "its transform".to_owned()
                     } else {
