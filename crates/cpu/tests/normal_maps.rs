@@ -137,3 +137,40 @@ fn generated_tangents_match_the_files_direction_and_sign() {
         );
     }
 }
+
+/// The normal-mapped quad placed as instances (turned, scaled unevenly, mirrored) bends its
+/// normals as its flattened copies do: tangents placed corner by corner, a mirroring
+/// placement's bitangent turned over.
+#[test]
+fn instances_bend_normals_as_their_flattened_copies() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = gltf_scene(&quad_gltf(dir.path(), true), None).unwrap();
+    let quad = std::sync::Arc::new(mesh(&scene).clone());
+    let turn = glam::Quat::from_rotation_y(0.4) * glam::Quat::from_rotation_z(0.3);
+    for scale in [Vec3::new(1.0, 0.6, 1.0), Vec3::new(-0.8, 0.6, 1.0)] {
+        let mut placed = scene.clone();
+        placed.objects[0].shape = Shape::Instance(pathlight_scene::Instance {
+            mesh: quad.clone(),
+            to_world: glam::Affine3A::from_scale_rotation_translation(scale, turn, Vec3::ZERO),
+        });
+        let mut flat = placed.clone();
+        flat.objects = pathlight_scene::testing::flattened(&placed.objects);
+        let to_world = glam::Affine3A::from_scale_rotation_translation(scale, turn, Vec3::ZERO);
+        let face = (to_world.matrix3.inverse().transpose() * glam::Vec3A::Z).normalize();
+        let (a, b) = (normals(placed), normals(flat));
+        // The map tilts the normal 30 degrees off the face wherever the quad is seen.
+        let bent = a
+            .pixels
+            .iter()
+            .filter(|p| {
+                let n = glam::Vec3A::from(Vec3::from(**p));
+                n.length() > 0.5 && n.dot(face).abs() < 0.95
+            })
+            .count();
+        assert!(bent >= 8, "scale {scale}: {bent} pixels see a bent normal");
+        for (i, (p, q)) in a.pixels.iter().zip(&b.pixels).enumerate() {
+            let (p, q) = (Vec3::from(*p), Vec3::from(*q));
+            assert!(p.distance(q) < 1e-3, "scale {scale}: pixel {i}: {p} vs {q}");
+        }
+    }
+}

@@ -431,8 +431,8 @@ transform = { translate = [-1, 0, 0], scale = 0.5 }
 }
 
 /// A mesh placed by several nodes (one of them mirroring, one reached through a parent) is
-/// read once and placed by each: every copy where its node puts it, none disturbed by the
-/// others' transforms.
+/// read once and placed by each as an instance of one shared copy: every placement where its
+/// node puts it, none disturbed by the others' transforms.
 #[test]
 fn a_mesh_placed_many_times_lands_where_each_node_puts_it() {
     let dir = tempfile::tempdir().unwrap();
@@ -451,10 +451,22 @@ fn a_mesh_placed_many_times_lands_where_each_node_puts_it() {
         Mat4::from_translation(Vec3::new(30.0, 5.0, 0.0)),
     ];
     assert_eq!(model.objects.len(), placements.len());
-    for (object, world) in model.objects.iter().zip(placements) {
-        let Shape::Mesh(mesh) = &object.shape else {
-            panic!("a mesh")
-        };
+    let shared: Vec<&pathlight_scene::Instance> = model
+        .objects
+        .iter()
+        .map(|o| match &o.shape {
+            Shape::Instance(instance) => instance,
+            other => panic!("{}: not an instance: {other:?}", o.name),
+        })
+        .collect();
+    assert!(
+        shared
+            .iter()
+            .all(|i| std::sync::Arc::ptr_eq(&i.mesh, &shared[0].mesh)),
+        "one copy of the mesh"
+    );
+    for ((object, world), instance) in model.objects.iter().zip(placements).zip(shared) {
+        let mesh = instance.flattened();
         let mut expected: Vec<Vec3> = corners
             .iter()
             .map(|c| world.transform_point3(Vec3::from(*c)))

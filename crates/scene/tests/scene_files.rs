@@ -51,8 +51,8 @@ fn shipped_scenes_load() {
         }
     }
     assert_eq!(
-        found, 25,
-        "default + outdoor + layers + nine reference scenes + 13 furnace rings"
+        found, 26,
+        "default + outdoor + layers + instances + nine reference scenes + 13 furnace rings"
     );
 }
 
@@ -95,6 +95,64 @@ fn obj_mesh_loads_with_its_transform() {
     assert_eq!(mesh.indices.len(), 4);
     assert!(mesh.positions.contains(&glam::Vec3::new(3.0, 0.0, 0.0)));
     assert!(mesh.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-5));
+}
+
+/// A mesh entry with `instances` places one shared copy of its triangles (in the OBJ file's
+/// space) by its own transform and by each instance's, each an object with its name and
+/// material; a placement beyond the coordinate limit or an unknown material names the line.
+#[test]
+fn a_mesh_with_instances_places_one_copy_many_times() {
+    let scene = load(
+        "[materials.m]\n[materials.n]\n\
+         [[mesh]]\nname = \"tetra\"\nmaterial = \"m\"\nfile = \"tetra.obj\"\n\
+         transform = { translate = [1, 0, 0] }\n\
+         instances = [\n\
+           { transform = { scale = 2 } },\n\
+           { name = \"mirror\", material = \"n\", transform = { scale = [-1, 1, 1] } },\n\
+         ]\n",
+    )
+    .unwrap();
+    let names: Vec<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
+    assert_eq!(names, ["tetra", "tetra#1", "mirror"]);
+    assert_eq!(
+        scene.objects.iter().map(|o| o.material).collect::<Vec<_>>(),
+        [0, 0, 1]
+    );
+    let placed: Vec<&pathlight_scene::Instance> = scene
+        .objects
+        .iter()
+        .map(|o| match &o.shape {
+            Shape::Instance(instance) => instance,
+            other => panic!("not an instance: {other:?}"),
+        })
+        .collect();
+    assert!(
+        placed
+            .iter()
+            .all(|p| std::sync::Arc::ptr_eq(&p.mesh, &placed[0].mesh)),
+        "one copy of the mesh"
+    );
+    assert_eq!(placed[0].mesh.indices.len(), 4);
+    let corner = placed[0].mesh.positions[0];
+    assert_eq!(
+        placed[0].to_world.transform_point3(corner),
+        corner + glam::Vec3::X
+    );
+    assert_eq!(placed[1].to_world.transform_point3(corner), corner * 2.0);
+    assert!(placed[2].to_world.matrix3.determinant() < 0.0);
+    let far = error(
+        "[materials.m]\n[[mesh]]\nmaterial = \"m\"\nfile = \"tetra.obj\"\n\
+         instances = [{ transform = { translate = [1e30, 0, 0] } }]\n",
+    );
+    assert!(
+        far.contains("test.toml:7") && far.contains("instances[0]"),
+        "{far}"
+    );
+    let unknown = error(
+        "[materials.m]\n[[mesh]]\nmaterial = \"m\"\nfile = \"tetra.obj\"\n\
+         instances = [{ material = \"nowhere\" }]\n",
+    );
+    assert!(unknown.contains("\"nowhere\" is not defined"), "{unknown}");
 }
 
 #[test]
