@@ -11,7 +11,7 @@ use obvhs::bvh2::builder::build_bvh2;
 use obvhs::bvh2::node::Bvh2Node;
 use rayon::slice::ParallelSliceMut;
 
-use crate::gpu_types::{GpuWideNode, SHAPE_LEAF};
+use crate::gpu_types::{GpuPrimitive, GpuWideNode, INSTANCE, SHAPE_LEAF};
 
 /// A binary tree over primitive boxes, and the order in which its leaves hold them.
 pub(crate) struct BinaryTree {
@@ -217,22 +217,36 @@ pub fn parents(nodes: &[GpuWideNode]) -> Vec<u32> {
 /// The root's entry in [`parents`].
 pub const NO_PARENT: u32 = u32::MAX;
 
-/// Most entries the traversal stacks of WGSL `trace_scene` and `trace_mesh` need in the
-/// trees at `roots` of `nodes` (in pre-order: the top level's at 0, each shared mesh's
-/// after it) to finish every walk with them. At each node the walk tests the entered leaves
-/// that hold shapes at once and pushes the other entered children but the nearest, and the
-/// stack holds only the pending entries of the current node and its ancestors (an entry is
-/// popped before its node is visited). At least 1: WGSL has no empty arrays.
-pub fn stack_bound(nodes: &[GpuWideNode], roots: &[u32]) -> u32 {
+/// Most entries the traversal stack of WGSL `trace_scene` needs in the trees of `nodes`
+/// (in pre-order: the top level's at 0, each shared mesh's after it, leaves indexing
+/// `primitives`) to finish every walk with it. At each node the walk tests the entered
+/// leaves that hold shapes at once (walking the meshes of the placements among them) and
+/// pushes the other entered children but the nearest; the stack holds only the pending
+/// entries of the current node and its ancestors (an entry is popped before its node is
+/// visited). A placement's mesh is walked above the top level's entries (`trace_mesh`), so
+/// the bound is the top level's plus the deepest mesh tree's. At least 1: WGSL has no empty
+/// arrays.
+pub fn stack_bound(nodes: &[GpuWideNode], primitives: &[GpuPrimitive]) -> u32 {
     // Most entries pushed along one path down from each node; children come after their
     // parent in pre-order, so a reverse sweep sees them first (no recursion on deep trees).
     let mut below = vec![0u32; nodes.len()];
+    let mut mesh_roots = Vec::new();
     for (index, n) in nodes.iter().enumerate().rev() {
         let used = (0..4).filter(|&lane| lane_used(n, lane));
         let pushed = used
             .clone()
             .filter(|&lane| n.count[lane] & SHAPE_LEAF == 0)
             .count() as u32;
+        for lane in used.clone().filter(|&lane| n.count[lane] & SHAPE_LEAF != 0) {
+            let first = n.first[lane] as usize;
+            let count = (n.count[lane] & !SHAPE_LEAF) as usize;
+            mesh_roots.extend(
+                primitives[first..first + count]
+                    .iter()
+                    .filter(|p| p.triangle == INSTANCE)
+                    .map(|p| p.root),
+            );
+        }
         let deepest = used
             .filter(|&lane| n.count[lane] == 0)
             .map(|lane| below[n.first[lane] as usize])
@@ -240,10 +254,10 @@ pub fn stack_bound(nodes: &[GpuWideNode], roots: &[u32]) -> u32 {
             .unwrap_or(0);
         below[index] = pushed.saturating_sub(1) + deepest;
     }
-    roots
+    let mesh = mesh_roots
         .iter()
         .map(|&root| below[root as usize])
         .max()
-        .unwrap_or(0)
-        .max(1)
+        .unwrap_or(0);
+    (below[0] + mesh).max(1)
 }

@@ -136,7 +136,6 @@ impl Geometry {
             stack_bound: 1,
             build_time: Duration::ZERO,
         };
-        let mut roots = vec![0];
         if !refs.is_empty() {
             let tree = bvh::build_binary(&bounds);
             let leaf_order: Vec<PrimitiveRef> = tree
@@ -157,7 +156,6 @@ impl Geometry {
             for (k, mesh) in shared.meshes.iter().enumerate() {
                 let root = out.lay_out_shared_mesh(mesh, shared.placed_by[k]);
                 mesh_roots.push(root);
-                roots.extend(root.map(|(root, _)| root));
             }
             for p in out.primitives.iter_mut().filter(|p| p.triangle == INSTANCE) {
                 let mesh = shared.mesh_of[p.object as usize] as usize;
@@ -171,7 +169,7 @@ impl Geometry {
                 }
             }
             out.parents = bvh::parents(&out.nodes);
-            out.stack_bound = bvh::stack_bound(&out.nodes, &roots);
+            out.stack_bound = bvh::stack_bound(&out.nodes, &out.primitives);
         }
         if out.vertices.is_empty() {
             out.vertices.push(GpuVertex::zeroed());

@@ -76,6 +76,7 @@ fn intersect_shape(i: u32, o: Object, ray: Ray, hit: ptr<function, Hit>) {
 
 // Hit on triangle `triangle` (its corners) of mesh object `object`, if nearer than `hit`.
 // A triangle of a mesh with alpha holes counts only where its texel stops the ray.
+// CPU twin: `CpuScene::hit_triangle`.
 fn hit_triangle(object: u32, triangle: u32, v0: vec3f, v1: vec3f, v2: vec3f, ray: ShearedRay, hit: ptr<function, Hit>) {
     let r = intersect_triangle(v0, v1, v2, ray, (*hit).t);
     if r.x < (*hit).t
