@@ -258,47 +258,16 @@ fn trace_scene(ray: Ray, t_max: f32, object_count: u32, any_hit: bool) -> Hit {
         // The other children still to visit (inner nodes, and leaves of triangles as LEAF
         // entries), sorted by entry distance: the nearest is taken next, the others are
         // pushed, farthest first.
-        let leaves = vec4u(LEAF | (index << 2u)) | vec4u(0u, 1u, 2u, 3u);
-        let entries = select(n.first, leaves, n.count != vec4u(0u));
-        let take = t < vec4f(hit.t) & !at_once;
-        var k0 = select(MISS, t.x, take.x);
-        var k1 = select(MISS, t.y, take.y);
-        var k2 = select(MISS, t.z, take.z);
-        var k3 = select(MISS, t.w, take.w);
-        var c0 = entries.x;
-        var c1 = entries.y;
-        var c2 = entries.z;
-        var c3 = entries.w;
-        order_pair(&k0, &c0, &k1, &c1);
-        order_pair(&k2, &c2, &k3, &c3);
-        order_pair(&k0, &c0, &k2, &c2);
-        order_pair(&k1, &c1, &k3, &c3);
-        order_pair(&k1, &c1, &k2, &c2);
-        let pushes = u32(k1 != MISS) + u32(k2 != MISS) + u32(k3 != MISS);
+        let o = order_children(n, index, t, t < vec4f(hit.t) & !at_once);
+        let pushes = u32(o.keys.y != MISS) + u32(o.keys.z != MISS) + u32(o.keys.w != MISS);
         if sp + pushes > STACK_SIZE {
             // Deeper than the stack: walk again from the root without one, keeping the hit.
             trace_stackless(ray, sheared, inv_dir, backwards, any_hit, &hit);
             return hit;
         }
-        if k3 != MISS {
-            stack[sp] = vec2u(c3, bitcast<u32>(k3));
-            sp++;
-        }
-        if k2 != MISS {
-            stack[sp] = vec2u(c2, bitcast<u32>(k2));
-            sp++;
-        }
-        if k1 != MISS {
-            stack[sp] = vec2u(c1, bitcast<u32>(k1));
-            sp++;
-        }
-        var next = c0;
-        if k0 == MISS {
-            next = pop_entry(&stack, &sp, 0u, hit.t);
-        }
+        var entry = push_children(&stack, &sp, 0u, o, hit.t);
         // Leaves of triangles, nearest first, until the next inner node ("while-while", Aila
         // and Laine: a warp's lanes intersect triangles together, then walk nodes together).
-        var entry = next;
         loop {
             if entry == NO_NODE {
                 return hit;

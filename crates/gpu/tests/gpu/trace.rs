@@ -249,19 +249,24 @@ fn room_rays(seed: u64, count: usize) -> Vec<TraceRay> {
 #[test]
 fn wgsl_traversal_matches_cpu_twin() {
     let prepared = PreparedScene::new(&default_scene::load().unwrap()).unwrap();
-    let rays = room_rays(5, 20_000);
+    check_every_scheme(&prepared, &room_rays(5, 20_000));
+}
+
+/// `rays` traced on the GPU with every scheme, and with the BVH walk on a one-entry stack,
+/// find what the CPU twin finds.
+fn check_every_scheme(prepared: &PreparedScene, rays: &[TraceRay]) {
     for accel in Accel::ALL {
         check_hits(
-            &prepared,
-            &rays,
-            &trace_on_gpu(&prepared, &rays, accel, integrator_stack(&prepared)),
+            prepared,
+            rays,
+            &trace_on_gpu(prepared, rays, accel, integrator_stack(prepared)),
             accel,
         );
     }
     check_hits(
-        &prepared,
-        &rays,
-        &trace_on_gpu(&prepared, &rays, Accel::Bvh, 1),
+        prepared,
+        rays,
+        &trace_on_gpu(prepared, rays, Accel::Bvh, 1),
         Accel::Bvh,
     );
 }
@@ -372,21 +377,7 @@ fn wgsl_traversal_matches_cpu_twin_through_instances() {
         scene.objects.push(Object { material, ..o });
     }
     let prepared = PreparedScene::new(&scene).unwrap();
-    let rays = room_rays(7, 20_000);
-    for accel in Accel::ALL {
-        check_hits(
-            &prepared,
-            &rays,
-            &trace_on_gpu(&prepared, &rays, accel, integrator_stack(&prepared)),
-            accel,
-        );
-    }
-    check_hits(
-        &prepared,
-        &rays,
-        &trace_on_gpu(&prepared, &rays, Accel::Bvh, 1),
-        Accel::Bvh,
-    );
+    check_every_scheme(&prepared, &room_rays(7, 20_000));
 }
 
 /// A scene whose only object is a mesh without triangles has no primitive: nothing is hit,
