@@ -2,9 +2,11 @@
 """Writes a GLB that places one bumpy sphere (2 x segments x rings triangles) on a square
 grid of `--placements` nodes, each turned and scaled at random, seen by a camera from a
 corner of the field: the instancing benchmark (BENCHMARKS.md, "Instancing"). With --placements 1 it is one mesh of that size; the
-default, 10,000 placements of a 10,000-triangle sphere, shows 100M triangles.
+default, 10,000 placements of a 10,000-triangle sphere, shows 100M triangles. --ply also
+writes the sphere alone as a binary PLY, for Mitsuba 3 (bench/first-frame.sh).
 
     python3 tools/forest_gltf.py out.glb [--placements 10000] [--segments 100] [--rings 50]
+                                 [--ply sphere.ply]
 """
 
 import argparse
@@ -48,14 +50,37 @@ def bumpy_sphere(segments, rings):
     return positions.astype(np.float32), normals.astype(np.float32), indices
 
 
+def write_ply(path, positions, normals, indices):
+    """`positions`, `normals` and `indices` as a binary little-endian PLY."""
+    vertices = np.concatenate([positions, normals], axis=1).astype("<f4")
+    faces = np.zeros(len(indices), dtype=[("n", "u1"), ("v", "<u4", (3,))])
+    faces["n"] = 3
+    faces["v"] = indices
+    header = (
+        "ply\nformat binary_little_endian 1.0\n"
+        f"element vertex {len(vertices)}\n"
+        "property float x\nproperty float y\nproperty float z\n"
+        "property float nx\nproperty float ny\nproperty float nz\n"
+        f"element face {len(faces)}\n"
+        "property list uchar uint vertex_indices\nend_header\n"
+    )
+    with open(path, "wb") as out:
+        out.write(header.encode())
+        out.write(vertices.tobytes())
+        out.write(faces.tobytes())
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("output")
     parser.add_argument("--placements", type=int, default=10_000)
     parser.add_argument("--segments", type=int, default=100)
     parser.add_argument("--rings", type=int, default=50)
+    parser.add_argument("--ply", help="also write the sphere alone to this PLY file")
     args = parser.parse_args()
     positions, normals, indices = bumpy_sphere(args.segments, args.rings)
+    if args.ply:
+        write_ply(args.ply, positions, normals, indices)
     blobs = [positions.tobytes(), normals.tobytes(), indices.astype(np.uint32).tobytes()]
     views, offset = [], 0
     for blob in blobs:

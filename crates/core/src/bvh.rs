@@ -3,24 +3,27 @@
 //! whose four child boxes a ray tests at once (in SIMD lanes on the CPU, as `vec4f`s in
 //! `bvh.wgsl`). A ray visits about half as many nodes as in the binary tree.
 
+use std::ops::Range;
 use std::time::Duration;
 
+use glam::Vec3A;
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::builder::build_bvh2;
 use obvhs::bvh2::node::Bvh2Node;
-use rayon::slice::ParallelSliceMut;
+use obvhs::ploc::morton::morton_encode_u32;
+use rayon::prelude::*;
 
 use crate::gpu_types::{GpuPrimitive, GpuWideNode, INSTANCE, SHAPE_LEAF};
 
 /// A binary tree over primitive boxes, and the order in which its leaves hold them.
-pub(crate) struct BinaryTree {
+struct BinaryTree {
     /// The nodes, root at 0: an inner node's children are `first_index` and
     /// `first_index + 1`; a leaf holds `first_index .. first_index + prim_count` of the
     /// reordered primitives.
-    pub nodes: Vec<Bvh2Node>,
+    nodes: Vec<Bvh2Node>,
     /// Per leaf slot, the index of the primitive box it holds.
-    pub primitive_indices: Vec<u32>,
+    primitive_indices: Vec<u32>,
 }
 
 /// Above this many primitives the tree is built with obvhs' fast preset (a narrower
@@ -38,16 +41,186 @@ fn preset(count: usize) -> BvhBuildParams {
     }
 }
 
-/// Builds the binary tree over `bounds` (not empty) with obvhs' medium preset
-/// (SAH-quality PLOC with reinsertion; its fast one for large inputs), on every core.
+/// When a tree is built in spatial chunks: with more than `above` primitives, in chunks of
+/// at most `size` (obvhs' builder keeps about 224 bytes of scratch a primitive it builds at
+/// once, more than the scene itself; a chunk at a time bounds it).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Chunks {
+    /// Most primitives built in one piece.
+    pub above: usize,
+    /// Most primitives in one chunk.
+    pub size: usize,
+}
+
+impl Chunks {
+    /// Scenes up to the fast preset's threshold (every reference scene) are built whole;
+    /// larger ones in chunks of 131,072 primitives (about 29 MB of builder scratch).
+    pub const DEFAULT: Self = Self {
+        above: FAST_BUILD_ABOVE,
+        size: 1 << 17,
+    };
+}
+
+/// Builds the 4-wide tree over `count` primitives (boxes by `bound_of`, `count` > 0) and
+/// appends it to `out` in pre-order; returns its root and the leaf order (per leaf slot,
+/// the primitive it holds). A leaf's slots are numbered from `primitive_base`; a leaf
+/// holding a primitive for which `is_shape` holds is marked [`SHAPE_LEAF`].
+///
+/// Up to `chunks.above` primitives one obvhs build covers them all. Above, the primitives
+/// are sorted along a Morton curve and split at its cells into chunks of at most
+/// `chunks.size`; a tree over the chunks' boxes (one chunk a leaf) is the top, and each
+/// chunk's own tree is built and collapsed under it in turn, so the builder's scratch is
+/// one chunk's, whatever the scene's size.
+pub(crate) fn build(
+    count: usize,
+    bound_of: &(dyn Fn(u32) -> Aabb + Sync),
+    is_shape: &dyn Fn(u32) -> bool,
+    primitive_base: u32,
+    chunks: Chunks,
+    out: &mut Vec<GpuWideNode>,
+) -> (u32, Vec<u32>) {
+    let params = preset(count);
+    if count <= chunks.above {
+        let bounds: Vec<Aabb> = (0..count as u32).into_par_iter().map(bound_of).collect();
+        let tree = build_binary(&bounds, params);
+        drop(bounds);
+        let order = tree.primitive_indices;
+        let root = collapse_node(
+            &tree.nodes,
+            &|leaf| leaf_lane(leaf, &order, is_shape, primitive_base),
+            0,
+            out,
+        );
+        return (root, order);
+    }
+    let curve = morton_order(count, bound_of);
+    let mut ranges = Vec::new();
+    split_cells(&curve, chunks.size, 0, &mut ranges);
+    let boxes: Vec<Aabb> = ranges
+        .par_iter()
+        .map(|r| {
+            curve[r.clone()]
+                .iter()
+                .fold(Aabb::empty(), |b, &(_, p)| b.union(&bound_of(p)))
+        })
+        .collect();
+    // The top: one chunk a leaf, each leaf lane a link to be set once its chunk is built.
+    let top_params = BvhBuildParams {
+        max_prims_per_leaf: 1,
+        ..BvhBuildParams::medium_build()
+    };
+    let top = build_bvh2(&boxes, top_params, &mut Duration::default());
+    let top_start = out.len();
+    let root = collapse_node(
+        &top.nodes,
+        &|leaf| (top.primitive_indices[leaf.first_index as usize], CHUNK_LINK),
+        0,
+        out,
+    );
+    let top_end = out.len();
+    let mut order = Vec::with_capacity(count);
+    let mut chunk_roots = Vec::with_capacity(ranges.len());
+    for range in ranges {
+        let members = &curve[range];
+        let bounds: Vec<Aabb> = members.par_iter().map(|&(_, p)| bound_of(p)).collect();
+        let tree = build_binary(&bounds, params);
+        drop(bounds);
+        let first = order.len();
+        order.extend(
+            tree.primitive_indices
+                .iter()
+                .map(|&i| members[i as usize].1),
+        );
+        let chunk_order = &order[first..];
+        let base = primitive_base + first as u32;
+        chunk_roots.push(collapse_node(
+            &tree.nodes,
+            &|leaf| leaf_lane(leaf, chunk_order, is_shape, base),
+            0,
+            out,
+        ));
+    }
+    for node in &mut out[top_start..top_end] {
+        for lane in 0..4 {
+            if lane_used(node, lane) && node.count[lane] == CHUNK_LINK {
+                node.first[lane] = chunk_roots[node.first[lane] as usize];
+                node.count[lane] = 0;
+            }
+        }
+    }
+    (root, order)
+}
+
+/// [`GpuWideNode::count`] of a top lane whose chunk is not built yet (its `first` names the
+/// chunk); [`build`] links it to the chunk's root.
+const CHUNK_LINK: u32 = u32::MAX;
+
+/// A wide node's `first` and `count` for binary leaf `leaf` of a tree whose leaf slots
+/// hold `order`, numbered from `base`.
+fn leaf_lane(
+    leaf: &Bvh2Node,
+    order: &[u32],
+    is_shape: &dyn Fn(u32) -> bool,
+    base: u32,
+) -> (u32, u32) {
+    let slots = leaf.first_index as usize..(leaf.first_index + leaf.prim_count) as usize;
+    let shape = order[slots].iter().any(|&p| is_shape(p));
+    let mark = if shape { SHAPE_LEAF } else { 0 };
+    (base + leaf.first_index, leaf.prim_count | mark)
+}
+
+/// The `count` primitives as `(Morton code of the box centre, primitive)`, sorted: 10 bits
+/// an axis of the centres' box, enough to cut chunks (each chunk's build sorts finer).
+fn morton_order(count: usize, bound_of: &(dyn Fn(u32) -> Aabb + Sync)) -> Vec<(u32, u32)> {
+    let centres = (0..count as u32)
+        .into_par_iter()
+        .map(|p| Aabb::from_point(bound_of(p).center()))
+        .reduce(Aabb::empty, |a, b| a.union(&b));
+    let extent = centres.diagonal();
+    let scale = Vec3A::select(extent.cmpgt(Vec3A::ZERO), 1023.0 / extent, Vec3A::ZERO);
+    let mut curve: Vec<(u32, u32)> = (0..count as u32)
+        .into_par_iter()
+        .map(|p| {
+            let cell = ((bound_of(p).center() - centres.min) * scale)
+                .clamp(Vec3A::ZERO, Vec3A::splat(1023.0));
+            (
+                morton_encode_u32(cell.x as u16, cell.y as u16, cell.z as u16),
+                p,
+            )
+        })
+        .collect();
+    curve.par_sort_unstable();
+    curve
+}
+
+/// Splits sorted `curve` (its first entry at `start` of the whole) at the highest bit in
+/// which its codes differ until every piece holds at most `size`, appending the pieces'
+/// ranges in curve order; a run of one code longer than `size` is halved.
+fn split_cells(curve: &[(u32, u32)], size: usize, start: usize, out: &mut Vec<Range<usize>>) {
+    if curve.len() <= size {
+        out.push(start..start + curve.len());
+        return;
+    }
+    let (first, last) = (curve[0].0, curve[curve.len() - 1].0);
+    let mid = if first == last {
+        curve.len() / 2
+    } else {
+        let bit = 1 << (31 - (first ^ last).leading_zeros());
+        curve.partition_point(|&(code, _)| code & bit == 0)
+    };
+    split_cells(&curve[..mid], size, start, out);
+    split_cells(&curve[mid..], size, start + mid, out);
+}
+
+/// Builds the binary tree over `bounds` (not empty) with preset `params`, on every core.
 /// Primitives with the very same box share one leaf: PLOC pairs nearest neighbours and
 /// breaks ties one way, so n identical boxes made a chain n/3 deep in O(n^2) (20,000
 /// coincident triangles: 11 s).
-pub(crate) fn build_binary(bounds: &[Aabb]) -> BinaryTree {
+fn build_binary(bounds: &[Aabb], params: BvhBuildParams) -> BinaryTree {
     let groups = IdenticalBoxes::of(bounds);
     let mut build_time = Duration::ZERO;
     if groups.count() == bounds.len() {
-        let tree = build_bvh2(bounds, preset(bounds.len()), &mut build_time);
+        let tree = build_bvh2(bounds, params, &mut build_time);
         return BinaryTree {
             nodes: tree.nodes,
             primitive_indices: tree.primitive_indices,
@@ -56,7 +229,7 @@ pub(crate) fn build_binary(bounds: &[Aabb]) -> BinaryTree {
     let unique: Vec<Aabb> = (0..groups.count())
         .map(|g| bounds[groups.members_of(g as u32)[0] as usize])
         .collect();
-    let tree = build_bvh2(&unique, preset(unique.len()), &mut build_time);
+    let tree = build_bvh2(&unique, params, &mut build_time);
     // Each leaf slot of the tree over unique boxes becomes the slots of its group.
     let mut slot_starts = Vec::with_capacity(tree.primitive_indices.len() + 1);
     let mut primitive_indices = Vec::with_capacity(bounds.len());
@@ -124,25 +297,13 @@ pub(crate) fn empty_tree() -> Vec<GpuWideNode> {
     }]
 }
 
-/// Appends the 4-wide form of `tree` to `out` in pre-order and returns its root's index.
-/// Each wide node takes the binary node's children and keeps opening its largest inner child
-/// (by surface area) until it has four. A leaf's primitives are the tree's leaf slots plus
-/// `primitive_base`; a leaf child holding a whole shape (`is_shape` of its first primitive
-/// slot ..) is marked [`SHAPE_LEAF`]; an unused child has an inverted box.
-pub(crate) fn collapse(
-    tree: &BinaryTree,
-    is_shape: &[bool],
-    primitive_base: u32,
-    out: &mut Vec<GpuWideNode>,
-) -> u32 {
-    collapse_node(&tree.nodes, is_shape, primitive_base, 0, out)
-}
-
-/// Appends the 4-wide form of the binary subtree at `root`; returns its node index.
+/// Appends the 4-wide form of the binary subtree of `nodes` at `root` to `out` in pre-order
+/// and returns its index. Each wide node takes the binary node's children and keeps opening
+/// its largest inner child (by surface area) until it has four; a leaf child's `first` and
+/// `count` are `leaf`'s; an unused child has an inverted box.
 fn collapse_node(
     nodes: &[Bvh2Node],
-    is_shape: &[bool],
-    primitive_base: u32,
+    leaf: &dyn Fn(&Bvh2Node) -> (u32, u32),
     root: u32,
     out: &mut Vec<GpuWideNode>,
 ) -> u32 {
@@ -172,15 +333,9 @@ fn collapse_node(
     for (lane, &child) in children.iter().enumerate() {
         let c = &nodes[child as usize];
         let (first, count) = if c.prim_count > 0 {
-            let slots = c.first_index as usize..(c.first_index + c.prim_count) as usize;
-            let shape = is_shape[slots].iter().any(|&s| s);
-            let mark = if shape { SHAPE_LEAF } else { 0 };
-            (primitive_base + c.first_index, c.prim_count | mark)
+            leaf(c)
         } else {
-            (
-                collapse_node(nodes, is_shape, primitive_base, child, out),
-                0,
-            )
+            (collapse_node(nodes, leaf, child, out), 0)
         };
         let n = &mut out[index as usize];
         let (lo, hi) = (c.aabb.min, c.aabb.max);

@@ -134,7 +134,8 @@ const _: () = assert!(size_of::<GpuWideNode>() == 128);
 /// it as soon as it enters the box instead of pushing it.
 pub const SHAPE_LEAF: u32 = 1 << 31;
 
-/// One triangle corner. WGSL: `Vertex`; a triangle is three consecutive vertices.
+/// One mesh vertex. WGSL: `Vertex`; a triangle names three ([`crate::Geometry::triangles`],
+/// WGSL `triangles`).
 /// Unit vectors are octahedral-encoded ([`crate::octahedral`]) to keep a corner in 32 bytes.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]

@@ -54,18 +54,18 @@ impl GpuInstance {
     }
 }
 
-/// The world corners of triangle `triangle` (in `vertices`, three corners each) of mesh
-/// `object`: placed by its transform when the object is an instance. Twin of WGSL
-/// `world_triangle`.
+/// The world corners of triangle `triangle` (in `triangles`, its corners' indices into
+/// `vertices`) of mesh `object`: placed by its transform when the object is an instance.
+/// Twin of WGSL `world_triangle`.
 #[inline(always)]
 pub fn world_triangle(
     object: &GpuObject,
     vertices: &[GpuVertex],
+    triangles: &[[u32; 3]],
     instances: &[GpuInstance],
     triangle: u32,
 ) -> [Vec3A; 3] {
-    let i = 3 * triangle as usize;
-    let corners = [0, 1, 2].map(|k| Vec3A::from(vertices[i + k].position));
+    let corners = triangles[triangle as usize].map(|v| Vec3A::from(vertices[v as usize].position));
     if object.flags & FLAG_INSTANCE == 0 {
         return corners;
     }

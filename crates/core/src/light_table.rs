@@ -23,13 +23,14 @@ pub fn luminance(rgb: Vec3) -> f32 {
 }
 
 /// Surface area of light-table entry `(object, primitive)`: the whole shape, or triangle
-/// `primitive` (in `vertices`) of a mesh (placed, for an instance, by its transform in
+/// `primitive` (in `triangles`, corners in `vertices`) of a mesh (placed, for an instance, by its transform in
 /// `instances`). The CPU backend's twin of WGSL `emitter_area` calls it, inlined into its
 /// row renderer (a call would make it save its vector registers).
 #[inline(always)]
 pub fn emitter_area(
     object: &GpuObject,
     vertices: &[GpuVertex],
+    triangles: &[[u32; 3]],
     instances: &[GpuInstance],
     primitive: u32,
 ) -> f32 {
@@ -47,7 +48,7 @@ pub fn emitter_area(
             std::f32::consts::TAU * r * (b - a).length() + caps * std::f32::consts::PI * r * r
         }
         _ => {
-            let [v0, v1, v2] = world_triangle(object, vertices, instances, primitive);
+            let [v0, v1, v2] = world_triangle(object, vertices, triangles, instances, primitive);
             0.5 * (v1 - v0).cross(v2 - v0).length()
         }
     }
@@ -94,8 +95,13 @@ pub fn build(
         object.light = table.len() as u32;
         for primitive in primitives {
             powers.push(
-                emitter_area(object, &geometry.vertices, &geometry.instances, primitive)
-                    * luminance,
+                emitter_area(
+                    object,
+                    &geometry.vertices,
+                    &geometry.triangles,
+                    &geometry.instances,
+                    primitive,
+                ) * luminance,
             );
             table.push(GpuLight {
                 kind: LIGHT_AREA,

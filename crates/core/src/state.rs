@@ -89,6 +89,7 @@ impl Fingerprint {
             bytemuck::cast_slice(&geometry.nodes),
             bytemuck::cast_slice(&geometry.primitives),
             bytemuck::cast_slice(&geometry.vertices),
+            bytemuck::cast_slice(&geometry.triangles),
             bytemuck::cast_slice(&geometry.shapes),
             bytemuck::cast_slice(&geometry.instances),
             bytemuck::cast_slice(&textures.texels),

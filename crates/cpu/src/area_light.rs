@@ -27,7 +27,13 @@ fn emitter_area(scene: &CpuScene, object: u32, o: &GpuObject, primitive: u32) ->
     if o.kind == KIND_QUAD {
         scene.quad_area(object)
     } else {
-        light_table::emitter_area(o, scene.vertices, scene.instances, primitive)
+        light_table::emitter_area(
+            o,
+            scene.vertices,
+            scene.triangles,
+            scene.instances,
+            primitive,
+        )
     }
 }
 
@@ -142,7 +148,13 @@ fn sample_shape(
             }
         }
         _ => {
-            let [v0, v1, v2] = world_triangle(o, scene.vertices, scene.instances, primitive);
+            let [v0, v1, v2] = world_triangle(
+                o,
+                scene.vertices,
+                scene.triangles,
+                scene.instances,
+                primitive,
+            );
             let su = u.x.sqrt();
             let (b1, b2) = (1.0 - su, u.y * su);
             let cross = (v1 - v0).cross(v2 - v0);

@@ -18,8 +18,10 @@ pub struct CpuScene<'a> {
     pub nodes: &'a [GpuWideNode],
     /// The BVH's primitives in leaf order (WGSL `primitives`).
     pub primitives: &'a [GpuPrimitive],
-    /// Triangle corners (WGSL `vertices`).
+    /// The meshes' vertices (WGSL `vertices`).
     pub vertices: &'a [GpuVertex],
+    /// Per triangle, its corners' indices into `vertices` (WGSL `triangles`).
+    pub triangles: &'a [[u32; 3]],
     /// The placements of instances (WGSL `instances`).
     pub instances: &'a [GpuInstance],
     /// Objects with their materials (WGSL `objects`).
@@ -62,6 +64,7 @@ impl<'a> CpuScene<'a> {
             nodes: &scene.geometry.nodes,
             primitives: &scene.geometry.primitives,
             vertices: &scene.geometry.vertices,
+            triangles: &scene.geometry.triangles,
             instances: &scene.geometry.instances,
             objects,
             materials: &scene.shading.materials,
@@ -88,10 +91,15 @@ impl<'a> CpuScene<'a> {
         self.quads[object as usize].1
     }
 
-    /// Triangle `i`'s corner positions (`i` in triangles of the vertex buffer).
+    /// Triangle `i`'s corner positions (`i` in `triangles`).
     #[inline(always)]
     pub fn triangle(&self, i: u32) -> [Vec3; 3] {
-        let i = 3 * i as usize;
-        [0, 1, 2].map(|k| Vec3::from(self.vertices[i + k].position))
+        self.corners(i).map(|v| Vec3::from(v.position))
+    }
+
+    /// Triangle `i`'s three corners.
+    #[inline(always)]
+    pub fn corners(&self, i: u32) -> [GpuVertex; 3] {
+        self.triangles[i as usize].map(|v| self.vertices[v as usize])
     }
 }

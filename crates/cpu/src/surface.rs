@@ -147,8 +147,7 @@ pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
             s.ns = s.ng;
         }
         _ => {
-            let i = 3 * hit.primitive as usize;
-            let [v0, v1, v2] = [0, 1, 2].map(|k| scene.vertices[i + k]);
+            let [v0, v1, v2] = scene.corners(hit.primitive);
             let b0 = 1.0 - hit.b1 - hit.b2;
             let [p0, p1, p2] = [v0, v1, v2].map(|v| Vec3A::from(v.position));
             let instance =

@@ -88,8 +88,7 @@ pub fn material_texture(scene: &CpuScene, m: &GpuMaterial, which: u32, uv: Vec2)
 
 /// Texture coordinates at barycentrics (b1, b2) of `triangle`. Twin of WGSL `triangle_uv`.
 pub fn triangle_uv(scene: &CpuScene, triangle: u32, b1: f32, b2: f32) -> Vec2 {
-    let i = 3 * triangle as usize;
-    let [v0, v1, v2] = [0, 1, 2].map(|k| Vec2::from(scene.vertices[i + k].uv));
+    let [v0, v1, v2] = scene.corners(triangle).map(|v| Vec2::from(v.uv));
     (1.0 - b1 - b2) * v0 + b1 * v1 + b2 * v2
 }
 
@@ -114,8 +113,7 @@ fn vertex_color(code: u32) -> Vec4 {
 /// have none. Twin of WGSL `triangle_color`.
 #[inline(always)]
 pub fn triangle_color(scene: &CpuScene, triangle: u32, b1: f32, b2: f32) -> Vec4 {
-    let i = 3 * triangle as usize;
-    let [c0, c1, c2] = [0, 1, 2].map(|k| scene.vertices[i + k].color);
+    let [c0, c1, c2] = scene.corners(triangle).map(|v| v.color);
     if c0 & c1 & c2 == WHITE {
         return Vec4::ONE;
     }

@@ -146,12 +146,12 @@ fn trace_instance_stackless(p: Primitive, ray: Ray, inv_dir: vec3f, backwards: v
     trace_mesh_stackless(p.root, p.object, local, sheared_ray(local), local_inv, local_inv < vec3f(0.0), any_hit, hit);
 }
 
-// Nearest hit among the triangles of mesh object `i`, read from `vertices`.
+// Nearest hit among the triangles of mesh object `i`, read from `triangles` and `vertices`.
 fn intersect_mesh(i: u32, o: Object, ray: ShearedRay, hit: ptr<function, Hit>) {
     for (var tri = o.first_triangle; tri < o.first_triangle + o.triangle_count; tri++) {
-        let v0 = vertices[3u * tri].position;
-        let v1 = vertices[3u * tri + 1u].position;
-        let v2 = vertices[3u * tri + 2u].position;
+        let v0 = vertices[triangles[3u * tri]].position;
+        let v1 = vertices[triangles[3u * tri + 1u]].position;
+        let v2 = vertices[triangles[3u * tri + 2u]].position;
         hit_triangle(i, tri, v0, v1, v2, ray, hit);
     }
 }

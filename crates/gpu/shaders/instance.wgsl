@@ -36,11 +36,15 @@ fn to_world_normal(m: Instance, n: vec3f) -> vec3f {
     return m.to_object[0].xyz * n.x + m.to_object[1].xyz * n.y + m.to_object[2].xyz * n.z;
 }
 
-// The world corners of triangle `triangle` (in `vertices`) of mesh object `o`: placed by its
-// transform when it is an instance.
+// The world corners of triangle `triangle` (in `triangles`, its corners in `vertices`) of mesh
+// object `o`: placed by its transform when it is an instance.
 fn world_triangle(o: Object, triangle: u32) -> array<vec3f, 3> {
     let i = 3u * triangle;
-    var corners = array<vec3f, 3>(vertices[i].position, vertices[i + 1u].position, vertices[i + 2u].position);
+    var corners = array<vec3f, 3>(
+        vertices[triangles[i]].position,
+        vertices[triangles[i + 1u]].position,
+        vertices[triangles[i + 2u]].position,
+    );
     if INSTANCES && (o.flags & FLAG_INSTANCE) != 0u {
         let m = instances[o.instance];
         for (var k = 0u; k < 3u; k++) {

@@ -165,6 +165,8 @@ struct Material {
 @group(0) @binding(0) var<storage, read> nodes: array<WideNode>;
 @group(0) @binding(1) var<storage, read> objects: array<Object>;
 @group(0) @binding(2) var<storage, read> vertices: array<Vertex>;
+// Per triangle, its three corners' indices into `vertices` (`pathlight_core::Geometry::triangles`).
+@group(0) @binding(13) var<storage, read> triangles: array<u32>;
 @group(0) @binding(3) var<storage, read> materials: array<Material>;
 @group(0) @binding(4) var<storage, read> texture_slots: array<TextureSlot>;
 @group(0) @binding(5) var<storage, read> texels: array<u32>;

@@ -122,9 +122,9 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
         }
         default: {
             let i = 3u * hit.primitive;
-            let v0 = vertices[i];
-            let v1 = vertices[i + 1u];
-            let v2 = vertices[i + 2u];
+            let v0 = vertices[triangles[i]];
+            let v1 = vertices[triangles[i + 1u]];
+            let v2 = vertices[triangles[i + 2u]];
             let b0 = 1.0 - hit.b1 - hit.b2;
             let instanced = INSTANCES && (o.flags & FLAG_INSTANCE) != 0u;
             var ng = cross(v1.position - v0.position, v2.position - v0.position);

@@ -72,7 +72,10 @@ fn material_texture(m: Material, which: u32, uv: vec2f) -> vec4f {
 // CPU twin: `triangle_uv`.
 fn triangle_uv(triangle: u32, b1: f32, b2: f32) -> vec2f {
     let i = 3u * triangle;
-    return (1.0 - b1 - b2) * vertices[i].uv + b1 * vertices[i + 1u].uv + b2 * vertices[i + 2u].uv;
+    let uv0 = vertices[triangles[i]].uv;
+    let uv1 = vertices[triangles[i + 1u]].uv;
+    let uv2 = vertices[triangles[i + 2u]].uv;
+    return (1.0 - b1 - b2) * uv0 + b1 * uv1 + b2 * uv2;
 }
 
 // A number in [0, 1) fixed by a triangle and a hit distance: the threshold of stochastic
@@ -98,9 +101,9 @@ fn vertex_color(code: u32) -> vec4f {
 // CPU twin: `triangle_color`.
 fn triangle_color(triangle: u32, b1: f32, b2: f32) -> vec4f {
     let i = 3u * triangle;
-    let c0 = vertices[i].color;
-    let c1 = vertices[i + 1u].color;
-    let c2 = vertices[i + 2u].color;
+    let c0 = vertices[triangles[i]].color;
+    let c1 = vertices[triangles[i + 1u]].color;
+    let c2 = vertices[triangles[i + 2u]].color;
     if (c0 & c1 & c2) == WHITE {
         return vec4f(1.0);
     }

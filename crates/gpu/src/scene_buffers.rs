@@ -15,7 +15,7 @@ use crate::pipeline::{bind_buffers, storage_entry};
 const MAX_NODES: usize = 1 << 28;
 
 /// Bindings of `scene.wgsl` and `environment.wgsl`, by number.
-const BINDINGS: usize = 13;
+const BINDINGS: usize = 14;
 
 /// The scene's buffers on the device and the bind group over them.
 #[derive(Debug)]
@@ -54,8 +54,8 @@ fn storage_buffer(
 }
 
 /// The geometry buffers: bindings 0 (nodes), 2 (vertices), 7 (primitives), 8 (the
-/// nodes' parents) and 12 (the instances' placements).
-fn geometry_contents(geometry: &Geometry) -> [(usize, &'static str, &[u8]); 5] {
+/// nodes' parents), 12 (the instances' placements) and 13 (the triangles' corners).
+fn geometry_contents(geometry: &Geometry) -> [(usize, &'static str, &[u8]); 6] {
     // A binding is never empty: a placeholder when there are no primitives.
     const PLACEHOLDER: [GpuPrimitive; 1] = [GpuPrimitive {
         v0: [0.0; 3],
@@ -70,12 +70,18 @@ fn geometry_contents(geometry: &Geometry) -> [(usize, &'static str, &[u8]); 5] {
     } else {
         bytemuck::cast_slice(&geometry.primitives)
     };
+    let triangles = if geometry.triangles.is_empty() {
+        bytemuck::cast_slice(&[[0u32; 3]])
+    } else {
+        bytemuck::cast_slice(&geometry.triangles)
+    };
     [
         (0, "bvh nodes", bytemuck::cast_slice(&geometry.nodes)),
         (2, "vertices", bytemuck::cast_slice(&geometry.vertices)),
         (7, "primitives", primitives),
         (8, "bvh parents", bytemuck::cast_slice(&geometry.parents)),
         (12, "instances", bytemuck::cast_slice(&geometry.instances)),
+        (13, "triangles", triangles),
     ]
 }
 

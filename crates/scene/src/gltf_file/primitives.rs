@@ -10,18 +10,20 @@ use crate::mesh::vertex_normals;
 use crate::shape::TriangleMesh;
 use crate::tangents::mikktspace_tangents;
 
-/// The triangles of a list, strip or fan of `count` indices, as glTF orders them (every
-/// triangle counter-clockwise from its front); `None` for points and lines.
-pub(super) fn triangles(mode: Mode, count: usize) -> Option<Vec<[usize; 3]>> {
+/// The triangles of a list, strip or fan of vertex indices `indices`, as glTF orders them
+/// (every triangle counter-clockwise from its front); `None` for points and lines.
+pub(super) fn triangles(mode: Mode, indices: &[u32]) -> Option<Vec<[u32; 3]>> {
+    let count = indices.len();
+    let corners = |c: [usize; 3]| c.map(|k| indices[k]);
     let tris = match mode {
         Mode::Triangles => (0..count / 3)
-            .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+            .map(|i| corners([3 * i, 3 * i + 1, 3 * i + 2]))
             .collect(),
         Mode::TriangleStrip => (0..count.saturating_sub(2))
-            .map(|i| [i, i + 1 + i % 2, i + 2 - i % 2])
+            .map(|i| corners([i, i + 1 + i % 2, i + 2 - i % 2]))
             .collect(),
         Mode::TriangleFan => (1..count.saturating_sub(1))
-            .map(|i| [i, i + 1, 0])
+            .map(|i| corners([i, i + 1, 0]))
             .collect(),
         Mode::Points | Mode::Lines | Mode::LineLoop | Mode::LineStrip => return None,
     };
@@ -102,17 +104,16 @@ pub(super) fn read_primitive(
         }
         None => None,
     };
-    let indices: Vec<usize> = match primitive.indices() {
+    let indices: Vec<u32> = match primitive.indices() {
         Some(accessor) => {
             let types = [DataType::U8, DataType::U16, DataType::U32];
             check("indices", &accessor, Dimensions::Scalar, &types)?;
-            let indices: Vec<usize> = reader
+            let indices: Vec<u32> = reader
                 .read_indices()
                 .ok_or_else(|| files.error(&element, "cannot read its indices"))?
                 .into_u32()
-                .map(|i| i as usize)
                 .collect();
-            if let Some(&bad) = indices.iter().find(|&&i| i >= count) {
+            if let Some(&bad) = indices.iter().find(|&&i| i as usize >= count) {
                 return Err(files.error(
                     &element,
                     format!("index {bad} is out of range: the primitive has {count} vertices"),
@@ -120,9 +121,9 @@ pub(super) fn read_primitive(
             }
             indices
         }
-        None => (0..count).collect(),
+        None => (0..count as u32).collect(),
     };
-    let Some(corners) = triangles(primitive.mode(), indices.len()) else {
+    let Some(mut kept) = triangles(primitive.mode(), &indices) else {
         log::warn!(
             "{}: {element} draws {:?}, which is skipped (only triangles render)",
             files.path.display(),
@@ -130,24 +131,17 @@ pub(super) fn read_primitive(
         );
         return Ok(None);
     };
-    let all: Vec<[u32; 3]> = corners
-        .iter()
-        .map(|c| c.map(|k| indices[k] as u32))
-        .collect();
-    let kept: Vec<[u32; 3]> = all
-        .iter()
-        .copied()
-        .filter(|t| {
-            let [a, b, c] = t.map(|i| positions[i as usize]);
-            (b - a).cross(c - a).length_squared() > 0.0
-        })
-        .collect();
-    if kept.len() < all.len() {
+    drop(indices);
+    let all = kept.len();
+    kept.retain(|t| {
+        let [a, b, c] = t.map(|i| positions[i as usize]);
+        (b - a).cross(c - a).length_squared() > 0.0
+    });
+    if kept.len() < all {
         log::warn!(
-            "{}: {element}: {} of its {} triangles have no area and are skipped",
+            "{}: {element}: {} of its {all} triangles have no area and are skipped",
             files.path.display(),
-            all.len() - kept.len(),
-            all.len()
+            all - kept.len(),
         );
     }
     if kept.is_empty() {
@@ -218,22 +212,24 @@ mod tests {
     fn strips_and_fans_follow_the_gltf_orders() {
         // glTF 2.0, 3.7.2.1: strip p_i = {v_i, v_{i+(1+i%2)}, v_{i+(2-i%2)}};
         // fan p_i = {v_{i+1}, v_{i+2}, v_0}.
+        // Indices 10, 11, ... name vertices 10, 11, ...: the triples are indices, not slots.
+        let first = |n: u32| (10..10 + n).collect::<Vec<u32>>();
         assert_eq!(
-            triangles(Mode::TriangleStrip, 5).unwrap(),
-            vec![[0, 1, 2], [1, 3, 2], [2, 3, 4]]
+            triangles(Mode::TriangleStrip, &first(5)).unwrap(),
+            vec![[10, 11, 12], [11, 13, 12], [12, 13, 14]]
         );
         assert_eq!(
-            triangles(Mode::TriangleFan, 5).unwrap(),
-            vec![[1, 2, 0], [2, 3, 0], [3, 4, 0]]
+            triangles(Mode::TriangleFan, &first(5)).unwrap(),
+            vec![[11, 12, 10], [12, 13, 10], [13, 14, 10]]
         );
         assert_eq!(
-            triangles(Mode::Triangles, 7).unwrap(),
-            vec![[0, 1, 2], [3, 4, 5]]
+            triangles(Mode::Triangles, &first(7)).unwrap(),
+            vec![[10, 11, 12], [13, 14, 15]]
         );
-        assert!(triangles(Mode::LineStrip, 5).is_none());
+        assert!(triangles(Mode::LineStrip, &first(5)).is_none());
         assert_eq!(
-            triangles(Mode::TriangleStrip, 2).unwrap(),
-            Vec::<[usize; 3]>::new()
+            triangles(Mode::TriangleStrip, &first(2)).unwrap(),
+            Vec::<[u32; 3]>::new()
         );
     }
 
