@@ -38,9 +38,10 @@ pub struct Geometry {
     pub nodes: Vec<GpuWideNode>,
     /// Every shape and triangle, in leaf order.
     pub primitives: Vec<GpuPrimitive>,
-    /// The meshes' vertices, each mesh's together: one per vertex of a mesh without
-    /// tangents, one per triangle corner of a mesh with them (its tangents are a corner's).
-    /// Never empty.
+    /// The meshes' vertices, each mesh's together in the order its triangles (in
+    /// [`Self::triangles`]) first name them: one per vertex a triangle names of a mesh
+    /// without tangents, one per triangle corner of a mesh with them (its tangents are a
+    /// corner's). Never empty.
     pub vertices: Vec<GpuVertex>,
     /// Per triangle, its corners' indices into [`Self::vertices`], each mesh's triangles
     /// together, in the order its leaves hold them (a triangle's index here is
@@ -235,16 +236,15 @@ impl Geometry {
         self.shapes.iter().map(|s| s.triangle_count as usize).sum()
     }
 
-    /// Fills the vertex buffer (each mesh's vertices together, in the scene's order), the
-    /// triangles (each mesh's together, in the order the leaves hold them, so that a leaf's
-    /// triangles lie side by side for shading too) and the primitives in leaf order. One
-    /// pass numbers the triangles; the buffers are then written in parallel, each to its
-    /// exact size (a 1M-triangle mesh without tangents: 16 MB of vertices, 12 MB of
-    /// triangles, 48 MB of primitives).
+    /// Fills the triangles (each mesh's together, in the order the leaves hold them, so
+    /// that a leaf's triangles lie side by side for shading too), the vertex buffer (each
+    /// mesh's vertices in the order its triangles first name them, [`Self::push_mesh`]) and
+    /// the primitives in leaf order. One pass numbers the triangles; the buffers are then
+    /// written each to its exact size (a 1M-triangle mesh without tangents: 16 MB of
+    /// vertices, 12 MB of triangles, 48 MB of primitives).
     fn lay_out_primitives(&mut self, objects: &[Object], leaf_order: &[PrimitiveRef]) {
-        // Per object, the triangle its next leaf-order triangle takes, and its first vertex.
+        // Per object, the triangle its next leaf-order triangle takes.
         let mut next = vec![0u32; objects.len()];
-        let mut first_vertex = vec![0u32; objects.len()];
         let mut total = 0u32;
         for (i, object) in objects.iter().enumerate() {
             if let Shape::Mesh(mesh) = &object.shape {
@@ -253,18 +253,10 @@ impl Geometry {
                 self.shapes[i].triangle_count = count;
                 next[i] = total;
                 total += count;
-                first_vertex[i] = self.vertices.len() as u32;
-                self.vertices.par_extend(mesh_vertices(mesh));
             }
         }
-        // Per leaf, its triangle; per triangle, its leaf's primitive.
-        let mut held = vec![
-            PrimitiveRef {
-                object: 0,
-                triangle: 0,
-            };
-            total as usize
-        ];
+        // Per triangle, its mesh's triangle; per leaf, its triangle.
+        let mut held = vec![0u32; total as usize];
         let slots: Vec<u32> = leaf_order
             .iter()
             .map(|p| {
@@ -273,22 +265,22 @@ impl Geometry {
                 }
                 let slot = next[p.object as usize];
                 next[p.object as usize] += 1;
-                held[slot as usize] = *p;
+                held[slot as usize] = p.triangle;
                 slot
             })
             .collect();
+        self.triangles.reserve_exact(total as usize);
+        for (i, object) in objects.iter().enumerate() {
+            if let Shape::Mesh(mesh) = &object.shape {
+                let first = self.shapes[i].first_triangle as usize;
+                self.push_mesh(mesh, &held[first..first + mesh.indices.len()]);
+            }
+        }
+        drop(held);
         let mesh_of = |p: &PrimitiveRef| match &objects[p.object as usize].shape {
             Shape::Mesh(mesh) => Some(mesh),
             _ => None,
         };
-        self.triangles = held
-            .par_iter()
-            .map(|p| match mesh_of(p) {
-                Some(mesh) => triangle_corners(mesh, p.triangle, first_vertex[p.object as usize]),
-                None => [0; 3], // Not reached: every slot is a mesh's.
-            })
-            .collect();
-        drop(held);
         self.primitives = leaf_order
             .par_iter()
             .zip(slots)
@@ -335,13 +327,7 @@ impl Geometry {
             &mut self.nodes,
         );
         let first_triangle = self.triangles.len() as u32;
-        let first_vertex = self.vertices.len() as u32;
-        self.vertices.par_extend(mesh_vertices(mesh));
-        self.triangles.par_extend(
-            order
-                .par_iter()
-                .map(|&t| triangle_corners(mesh, t, first_vertex)),
-        );
+        self.push_mesh(mesh, &order);
         self.primitives
             .par_extend(order.par_iter().enumerate().map(|(slot, &t)| {
                 let [v0, v1, v2] =
@@ -356,6 +342,46 @@ impl Geometry {
                 }
             }));
         Some((root, first_triangle))
+    }
+
+    /// Appends triangles `order` of `mesh` (in that order) to the triangles and their
+    /// vertices to the vertex buffer: each vertex once, numbered as the triangles first name
+    /// it (so that the corners of a leaf's triangles lie close together, as its triangles
+    /// do), or for a mesh with tangents (one a corner) three vertices a triangle.
+    fn push_mesh(&mut self, mesh: &TriangleMesh, order: &[u32]) {
+        let first = self.vertices.len() as u32;
+        if !mesh.tangents.is_empty() {
+            self.vertices
+                .par_extend((0..3 * order.len()).into_par_iter().map(|c| {
+                    let corner = 3 * order[c / 3] as usize + c % 3;
+                    let t = mesh.tangents[corner];
+                    let tangent = octahedral::encode_tangent(t.truncate(), t.w);
+                    gpu_vertex(mesh, mesh.indices[corner / 3][corner % 3], tangent)
+                }));
+            self.triangles
+                .extend((0..order.len() as u32).map(|s| [0, 1, 2].map(|k| first + 3 * s + k)));
+            return;
+        }
+        // Per vertex of the mesh, its number here; per number, the mesh's vertex.
+        let mut number = vec![u32::MAX; mesh.positions.len()];
+        let mut named = Vec::with_capacity(mesh.positions.len());
+        for &t in order {
+            let corners = mesh.indices[t as usize].map(|v| {
+                let n = &mut number[v as usize];
+                if *n == u32::MAX {
+                    *n = named.len() as u32;
+                    named.push(v);
+                }
+                first + *n
+            });
+            self.triangles.push(corners);
+        }
+        drop(number);
+        self.vertices.par_extend(
+            named
+                .par_iter()
+                .map(|&v| gpu_vertex(mesh, v, octahedral::ZERO)),
+        );
     }
 }
 
@@ -593,40 +619,15 @@ fn gpu_shape(shape: &Shape, bounds: &Aabb) -> GpuObject {
     o
 }
 
-/// The vertices of `mesh` as the vertex buffer holds them: one per vertex, or one per
-/// triangle corner when the mesh has (per-corner) tangents.
-fn mesh_vertices(mesh: &TriangleMesh) -> impl IndexedParallelIterator<Item = GpuVertex> + '_ {
-    let per_corner = !mesh.tangents.is_empty();
-    let count = if per_corner {
-        3 * mesh.indices.len()
-    } else {
-        mesh.positions.len()
-    };
-    (0..count).into_par_iter().map(move |i| {
-        let (v, tangent) = if per_corner {
-            let v = mesh.indices[i / 3][i % 3] as usize;
-            let t = mesh.tangents[i];
-            (v, octahedral::encode_tangent(t.truncate(), t.w))
-        } else {
-            (i, octahedral::ZERO)
-        };
-        GpuVertex {
-            position: mesh.positions[v].to_array(),
-            normal: octahedral::encode(mesh.normals.get(v).copied().unwrap_or_default()),
-            uv: mesh.uvs.get(v).copied().unwrap_or_default().to_array(),
-            tangent,
-            color: mesh.colors.get(v).map_or(WHITE, |&c| pack_color(c)),
-        }
-    })
-}
-
-/// The vertex-buffer indices of triangle `t`'s corners, `mesh`'s vertices starting at
-/// `first_vertex` ([`mesh_vertices`]).
-fn triangle_corners(mesh: &TriangleMesh, t: u32, first_vertex: u32) -> [u32; 3] {
-    if mesh.tangents.is_empty() {
-        mesh.indices[t as usize].map(|v| first_vertex + v)
-    } else {
-        [0, 1, 2].map(|k| first_vertex + 3 * t + k)
+/// Vertex `v` of `mesh` as the vertex buffer holds it, with tangent code `tangent`.
+fn gpu_vertex(mesh: &TriangleMesh, v: u32, tangent: u32) -> GpuVertex {
+    let v = v as usize;
+    GpuVertex {
+        position: mesh.positions[v].to_array(),
+        normal: octahedral::encode(mesh.normals.get(v).copied().unwrap_or_default()),
+        uv: mesh.uvs.get(v).copied().unwrap_or_default().to_array(),
+        tangent,
+        color: mesh.colors.get(v).map_or(WHITE, |&c| pack_color(c)),
     }
 }
 
