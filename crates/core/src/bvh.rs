@@ -68,13 +68,14 @@ impl Chunks {
 ///
 /// Up to `chunks.above` primitives one obvhs build covers them all. Above, the primitives
 /// are sorted along a Morton curve and split at its cells into chunks of at most
-/// `chunks.size`; a tree over the chunks' boxes (one chunk a leaf) is the top, and each
-/// chunk's own tree is built and collapsed under it in turn, so the builder's scratch is
-/// one chunk's, whatever the scene's size.
+/// `chunks.size`; a tree over the chunks' boxes (one chunk a leaf) is the top, and the
+/// chunks' own trees are built (a thread's worth at a time) and collapsed under it, so the
+/// builder's scratch is a few chunks', whatever the scene's size. The result does not
+/// depend on the thread count.
 pub(crate) fn build(
     count: usize,
     bound_of: &(dyn Fn(u32) -> Aabb + Sync),
-    is_shape: &dyn Fn(u32) -> bool,
+    is_shape: &(dyn Fn(u32) -> bool + Sync),
     primitive_base: u32,
     chunks: Chunks,
     out: &mut Vec<GpuWideNode>,
@@ -118,27 +119,52 @@ pub(crate) fn build(
         out,
     );
     let top_end = out.len();
+    // As many chunks at a time as there are threads (obvhs' own build keeps two cores
+    // half idle on a chunk), each collapsed on its own and moved in after the last.
     let mut order = Vec::with_capacity(count);
     let mut chunk_roots = Vec::with_capacity(ranges.len());
-    for range in ranges {
-        let members = &curve[range];
-        let bounds: Vec<Aabb> = members.par_iter().map(|&(_, p)| bound_of(p)).collect();
-        let tree = build_binary(&bounds, params);
-        drop(bounds);
-        let first = order.len();
-        order.extend(
-            tree.primitive_indices
-                .iter()
-                .map(|&i| members[i as usize].1),
-        );
-        let chunk_order = &order[first..];
-        let base = primitive_base + first as u32;
-        chunk_roots.push(collapse_node(
-            &tree.nodes,
-            &|leaf| leaf_lane(leaf, chunk_order, is_shape, base),
-            0,
-            out,
-        ));
+    for batch in ranges.chunks(rayon::current_num_threads().max(1)) {
+        let built: Vec<(Vec<GpuWideNode>, Vec<u32>)> = batch
+            .par_iter()
+            .map(|range| {
+                let members = &curve[range.clone()];
+                let bounds: Vec<Aabb> = members.iter().map(|&(_, p)| bound_of(p)).collect();
+                let tree = build_binary(&bounds, params);
+                drop(bounds);
+                let chunk_order: Vec<u32> = tree
+                    .primitive_indices
+                    .iter()
+                    .map(|&i| members[i as usize].1)
+                    .collect();
+                let mut nodes = Vec::new();
+                collapse_node(
+                    &tree.nodes,
+                    &|leaf| leaf_lane(leaf, &chunk_order, is_shape, 0),
+                    0,
+                    &mut nodes,
+                );
+                (nodes, chunk_order)
+            })
+            .collect();
+        for (nodes, chunk_order) in built {
+            let node_base = out.len() as u32;
+            let slot_base = primitive_base + order.len() as u32;
+            chunk_roots.push(node_base);
+            out.extend(nodes.into_iter().map(|mut n| {
+                for lane in 0..4 {
+                    if !lane_used(&n, lane) {
+                        continue;
+                    }
+                    n.first[lane] += if n.count[lane] == 0 {
+                        node_base
+                    } else {
+                        slot_base
+                    };
+                }
+                n
+            }));
+            order.extend(chunk_order);
+        }
     }
     for node in &mut out[top_start..top_end] {
         for lane in 0..4 {

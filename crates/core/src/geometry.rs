@@ -84,7 +84,7 @@ impl Geometry {
         let shared = SharedMeshes::of(objects);
         for (k, mesh) in shared.meshes.iter().enumerate() {
             let first = shared.placed_by[k];
-            check_shape(&Shape::Mesh((*mesh).clone())).map_err(|message| GeometryError {
+            check_mesh(mesh).map_err(|message| GeometryError {
                 object: objects[first as usize].name.clone(),
                 message: format!("its mesh: {message}"),
             })?;
@@ -481,30 +481,7 @@ fn check_shape(shape: &Shape) -> Result<(), String> {
             }
             Ok(())
         }
-        Shape::Mesh(mesh) => {
-            for (i, p) in mesh.positions.iter().enumerate() {
-                point(&format!("vertex {i}"), *p)?;
-            }
-            if !mesh.tangents.is_empty() && mesh.tangents.len() != 3 * mesh.indices.len() {
-                return Err(format!(
-                    "it has {} tangents for {} triangle corners",
-                    mesh.tangents.len(),
-                    3 * mesh.indices.len()
-                ));
-            }
-            let count = mesh.positions.len() as u32;
-            match mesh
-                .indices
-                .iter()
-                .position(|t| t.iter().any(|&i| i >= count))
-            {
-                Some(t) => Err(format!(
-                    "triangle {t} names vertex {:?}; the mesh has {count}",
-                    mesh.indices[t]
-                )),
-                None => Ok(()),
-            }
-        }
+        Shape::Mesh(mesh) => check_mesh(mesh),
         Shape::Instance(instance) => {
             // Its mesh is checked once, with the other placements' (`Geometry::build`).
             if !instance.to_world.is_finite() {
@@ -517,6 +494,42 @@ fn check_shape(shape: &Shape) -> Result<(), String> {
             point("its placed box's corner", min)?;
             point("its placed box's corner", max)
         }
+    }
+}
+
+/// Why `mesh` cannot be built, if it cannot: a vertex not finite or beyond
+/// [`MAX_COORDINATE`], a triangle naming a vertex it does not have, tangents not one a
+/// triangle corner.
+fn check_mesh(mesh: &TriangleMesh) -> Result<(), String> {
+    let limit = Vec3::splat(MAX_COORDINATE);
+    if let Some(i) = mesh
+        .positions
+        .par_iter()
+        .position_first(|p| !p.abs().cmple(limit).all())
+    {
+        let p = mesh.positions[i];
+        return Err(format!(
+            "vertex {i} {p} is not finite or beyond +-{MAX_COORDINATE:e}"
+        ));
+    }
+    if !mesh.tangents.is_empty() && mesh.tangents.len() != 3 * mesh.indices.len() {
+        return Err(format!(
+            "it has {} tangents for {} triangle corners",
+            mesh.tangents.len(),
+            3 * mesh.indices.len()
+        ));
+    }
+    let count = mesh.positions.len() as u32;
+    match mesh
+        .indices
+        .par_iter()
+        .position_first(|t| t.iter().any(|&i| i >= count))
+    {
+        Some(t) => Err(format!(
+            "triangle {t} names vertex {:?}; the mesh has {count}",
+            mesh.indices[t]
+        )),
+        None => Ok(()),
     }
 }
 
@@ -1114,8 +1127,9 @@ mod tests {
 
     #[test]
     fn the_build_does_not_depend_on_the_thread_count() {
-        // obvhs' build and the buffer fill run on rayon: one thread and four give the same
-        // tree and buffers, so a seeded render is the same image on any machine.
+        // obvhs' build, the chunks' builds and the buffer fill run on rayon: one thread and
+        // four give the same tree and buffers, whole or in chunks (of 1,000 here, some
+        // built at once), so a seeded render is the same image on any machine.
         let mut rng = StdRng::seed_from_u64(13);
         let mut objects: Vec<Object> = random_objects(&mut rng, 40);
         objects.push(object(
@@ -1123,24 +1137,33 @@ mod tests {
             Shape::Mesh(random_mesh(&mut rng, 30_000, Vec3::ZERO)),
         ));
         let scene = scene_of(objects);
-        let build_on = |threads| {
+        let build_on = |threads, chunks| {
             rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
                 .expect("a thread pool")
-                .install(|| Geometry::build(&scene.objects).unwrap())
+                .install(|| Geometry::build_in(&scene.objects, chunks).unwrap())
         };
-        let (one, four) = (build_on(1), build_on(4));
-        validate(&four);
-        let bytes = |g: &Geometry| {
-            [
-                bytemuck::cast_slice::<_, u8>(&g.nodes).to_vec(),
-                bytemuck::cast_slice(&g.primitives).to_vec(),
-                bytemuck::cast_slice(&g.vertices).to_vec(),
-                bytemuck::cast_slice(&g.triangles).to_vec(),
-                bytemuck::cast_slice(&g.shapes).to_vec(),
-            ]
+        let chunked = bvh::Chunks {
+            above: 10_000,
+            size: 1000,
         };
-        assert!(bytes(&one) == bytes(&four), "the buffers differ");
+        for chunks in [bvh::Chunks::DEFAULT, chunked] {
+            let (one, four) = (build_on(1, chunks), build_on(4, chunks));
+            validate(&four);
+            let bytes = |g: &Geometry| {
+                [
+                    bytemuck::cast_slice::<_, u8>(&g.nodes).to_vec(),
+                    bytemuck::cast_slice(&g.primitives).to_vec(),
+                    bytemuck::cast_slice(&g.vertices).to_vec(),
+                    bytemuck::cast_slice(&g.triangles).to_vec(),
+                    bytemuck::cast_slice(&g.shapes).to_vec(),
+                ]
+            };
+            assert!(
+                bytes(&one) == bytes(&four),
+                "the buffers differ ({chunks:?})"
+            );
+        }
     }
 }
