@@ -43,7 +43,7 @@ fn preset(count: usize) -> BvhBuildParams {
 
 /// When a tree is built in spatial chunks: with more than `above` primitives, in chunks of
 /// at most `size` (obvhs' builder keeps about 224 bytes of scratch a primitive it builds at
-/// once, more than the scene itself; a chunk at a time bounds it).
+/// once, more than the scene itself; a few chunks at a time bound it).
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Chunks {
     /// Most primitives built in one piece.
@@ -54,7 +54,9 @@ pub(crate) struct Chunks {
 
 impl Chunks {
     /// Scenes up to the fast preset's threshold (every reference scene) are built whole;
-    /// larger ones in chunks of 131,072 primitives (about 29 MB of builder scratch).
+    /// larger ones in chunks of 131,072 primitives (about 29 MB of builder scratch). Larger
+    /// chunks build slower: a 16.8M-triangle mesh in chunks of 1,048,576 took 12.3 s to its
+    /// first frame against 7.2-7.4 s (BENCHMARKS.md).
     pub const DEFAULT: Self = Self {
         above: FAST_BUILD_ABOVE,
         size: 1 << 17,
@@ -68,10 +70,9 @@ impl Chunks {
 ///
 /// Up to `chunks.above` primitives one obvhs build covers them all. Above, the primitives
 /// are sorted along a Morton curve and split at its cells into chunks of at most
-/// `chunks.size`; a tree over the chunks' boxes (one chunk a leaf) is the top, and the
-/// chunks' own trees are built (a thread's worth at a time) and collapsed under it, so the
-/// builder's scratch is a few chunks', whatever the scene's size. The result does not
-/// depend on the thread count.
+/// `chunks.size`; a tree over the chunks' boxes (one chunk a leaf) is the top, and
+/// the chunks' own trees are built (a few at a time) and collapsed under it, so the
+/// builder's scratch is a few chunks'. The result does not depend on the thread count.
 pub(crate) fn build(
     count: usize,
     bound_of: &(dyn Fn(u32) -> Aabb + Sync),
@@ -96,7 +97,8 @@ pub(crate) fn build(
     }
     let curve = morton_order(count, bound_of);
     let mut ranges = Vec::new();
-    split_cells(&curve, chunks.size, 0, &mut ranges);
+    let size = chunks.size;
+    split_cells(&curve, size, 0, &mut ranges);
     let boxes: Vec<Aabb> = ranges
         .par_iter()
         .map(|r| {
@@ -119,11 +121,14 @@ pub(crate) fn build(
         out,
     );
     let top_end = out.len();
-    // As many chunks at a time as there are threads (obvhs' own build keeps two cores
-    // half idle on a chunk), each collapsed on its own and moved in after the last.
+    // Up to as many chunks at a time as there are threads (obvhs' own build keeps two cores
+    // half idle on a chunk) while their scratch stays under 28 bytes a primitive of the
+    // scene (an eighth of them built at once), each collapsed on its own and moved in after
+    // the last.
     let mut order = Vec::with_capacity(count);
     let mut chunk_roots = Vec::with_capacity(ranges.len());
-    for batch in ranges.chunks(rayon::current_num_threads().max(1)) {
+    let at_once = (count / (8 * size)).clamp(1, rayon::current_num_threads().max(1));
+    for batch in ranges.chunks(at_once) {
         let built: Vec<(Vec<GpuWideNode>, Vec<u32>)> = batch
             .par_iter()
             .map(|range| {
