@@ -818,7 +818,7 @@ fn a_gltf_file_with_every_supported_material_extension_renders_without_warnings(
 }
 
 /// A glTF file placing one triangle 400 times keeps it once, as 400 instances, and needs
-/// about 320 + 400 x 512 bytes: a `PATHLIGHT_MEMORY_LIMIT` below that refuses it before
+/// about 280 + 400 x 512 bytes: a `PATHLIGHT_MEMORY_LIMIT` below that refuses it before
 /// reading it, naming the file, the meshes, placements, triangles, instances and bytes (exit
 /// status 1, no abort); one above renders it; a limit that is not a size is refused naming
 /// the variable.
@@ -865,7 +865,7 @@ fn a_gltf_too_large_for_the_memory_limit_is_refused_saying_how_large() {
     let err = stderr(&refused);
     assert_eq!(refused.status.code(), Some(1), "{err}");
     assert!(
-        err.contains("many.gltf: scene 0: places 1 meshes 400 times: 1 triangles and 400 instances need about 200.3 KiB (about 320 bytes a triangle, 512 an instance), more than the 64.0 KiB PATHLIGHT_MEMORY_LIMIT allows"),
+        err.contains("many.gltf: scene 0: places 1 meshes 400 times: 1 triangles and 400 instances need about 200.3 KiB (about 280 bytes a triangle, 512 an instance), more than the 64.0 KiB PATHLIGHT_MEMORY_LIMIT allows"),
         "{err}"
     );
     let rendered = render("1M");

@@ -5,10 +5,10 @@
 use std::fmt;
 
 /// Peak bytes a triangle costs from its file to the first frame on the CPU backend, rounded
-/// up: 289 measured for a 1,048,576-triangle mesh (`bench/scenes/million-triangles.toml`:
-/// 298 MiB peak, 9 MiB of it the process itself), about 310 for glTF meshes with normals and
-/// texture coordinates.
-pub const BYTES_PER_TRIANGLE: u64 = 320;
+/// up for the costliest kind: a mesh without tangents peaks at 134-161 (whole process;
+/// `bench/first-frame.sh`'s 1M-16.8M-triangle GLBs, `bench/scenes/million-triangles.toml`
+/// 148), a normal-mapped one keeps a vertex and a tangent a triangle corner (about 270).
+pub const BYTES_PER_TRIANGLE: u64 = 280;
 
 /// Bytes a placement of a shared mesh costs beyond its mesh, rounded up: its object in the
 /// scene (name, shape) and in the backends (object record, transforms, top-level primitive
@@ -214,7 +214,7 @@ mod tests {
         let message = budget.check(triangles(10_000_000)).unwrap_err();
         assert_eq!(
             message,
-            "10000000 triangles need about 3.0 GiB (about 320 bytes each), more than the 1.0 GiB PATHLIGHT_MEMORY_LIMIT allows"
+            "10000000 triangles need about 2.6 GiB (about 280 bytes each), more than the 1.0 GiB PATHLIGHT_MEMORY_LIMIT allows"
         );
         // A mesh of 10,000 triangles placed 10,000 times: its triangles once, and the
         // placements.
@@ -229,7 +229,7 @@ mod tests {
         };
         assert_eq!(
             budget.check(many).unwrap_err(),
-            "10000 triangles and 3000000 instances need about 1.4 GiB (about 320 bytes a triangle, 512 an instance), more than the 1.0 GiB PATHLIGHT_MEMORY_LIMIT allows"
+            "10000 triangles and 3000000 instances need about 1.4 GiB (about 280 bytes a triangle, 512 an instance), more than the 1.0 GiB PATHLIGHT_MEMORY_LIMIT allows"
         );
         assert_eq!(Bytes(1536).to_string(), "1.5 KiB");
         assert_eq!(Bytes(12).to_string(), "12 bytes");
