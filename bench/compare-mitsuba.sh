@@ -10,21 +10,30 @@
 # ratio, (Mitsuba time x Mitsuba relMSE) / (pathlight time x pathlight relMSE): above 1,
 # pathlight reaches an error first (Monte Carlo error falls as 1/time).
 #
-# Installs what it needs: Debian's libllvm19 and python3-venv (apt-get, as root or with
-# sudo), then Mitsuba and NumPy from pip into a virtual environment (MITSUBA_VENV, default
-# bench/.venv).
+# On a GPU machine, `--backend gpu --variant cuda_ad_rgb` compares pathlight's GPU backend
+# with Mitsuba's CUDA variant; both sides are then timed by render time alone (pathlight's as
+# its `render` reports it), since a GPU process's start (driver, shader compilation) dwarfs
+# a small render. Every round's times are printed, so the best of them can be read too.
 #
-#   bash bench/compare-mitsuba.sh [--res N] [--spp N] [--rounds N] [SCENE...]
-#     defaults: 256x256, 256 spp, 3 rounds, every scene
+# Installs what it needs: Debian's libllvm19 (for an llvm variant) and python3-venv (apt-get,
+# as root or with sudo), then Mitsuba and NumPy from pip into a virtual environment
+# (MITSUBA_VENV, default bench/.venv). MITSUBA_PYTHON=path/to/python uses a Python that
+# already has them instead (nothing installed).
+#
+#   bash bench/compare-mitsuba.sh [--res N] [--spp N] [--rounds N] [--backend cpu|gpu]
+#                                 [--variant V] [SCENE...]
+#     defaults: 256x256, 256 spp, 3 rounds, --backend cpu, --variant llvm_ad_rgb, every scene
 #   PATHLIGHT=path/to/binary selects the pathlight binary (default: a fresh release build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-RES=256 SPP=256 ROUNDS=3 SCENES=()
+RES=256 SPP=256 ROUNDS=3 BACKEND=cpu VARIANT=llvm_ad_rgb SCENES=()
 while [ $# -gt 0 ]; do
     case "$1" in
         --res) RES=$2; shift 2 ;;
         --spp) SPP=$2; shift 2 ;;
         --rounds) ROUNDS=$2; shift 2 ;;
+        --backend) BACKEND=$2; shift 2 ;;
+        --variant) VARIANT=$2; shift 2 ;;
         *) SCENES+=("$1"); shift ;;
     esac
 done
@@ -39,26 +48,31 @@ VENV=${MITSUBA_VENV:-bench/.venv}
 LLVM=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1
 
 sudo_if_needed() { if [ "$(id -u)" = 0 ]; then "$@"; else sudo "$@"; fi; }
-if [ ! -e "$LLVM" ] || ! python3 -c 'import venv, ensurepip' 2>/dev/null; then
-    sudo_if_needed apt-get update
-    sudo_if_needed apt-get install -y libllvm19 python3-venv
+if [ -n "${MITSUBA_PYTHON:-}" ]; then
+    PY=$MITSUBA_PYTHON
+else
+    PY=$VENV/bin/python
+    if { [[ $VARIANT == llvm* ]] && [ ! -e "$LLVM" ]; } || ! python3 -c 'import venv, ensurepip' 2>/dev/null; then
+        sudo_if_needed apt-get update
+        sudo_if_needed apt-get install -y libllvm19 python3-venv
+    fi
+    if [ ! -x "$PY" ]; then
+        python3 -m venv "$VENV"
+        "$VENV/bin/pip" install --quiet mitsuba numpy
+    fi
 fi
-if [ ! -x "$VENV/bin/python" ]; then
-    python3 -m venv "$VENV"
-    "$VENV/bin/pip" install --quiet mitsuba numpy
-fi
-export DRJIT_LIBLLVM_PATH=$LLVM
+[ -e "$LLVM" ] && export DRJIT_LIBLLVM_PATH=$LLVM
 if [ -z "${PATHLIGHT:-}" ]; then
     cargo build --release --locked --quiet
     PATHLIGHT=./target/release/pathlight
 fi
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-isa=$("$PATHLIGHT" render scenes/refs/furnace-0.8.toml --backend cpu --width 8 --height 8 --spp 1 \
-    -o "$out/probe.png" 2>&1 | sed -n 's/.*backend: cpu backend, \(.*\)/\1/p')
-echo "$(date -u +%F), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(nproc) cores, pathlight $isa"
+device=$("$PATHLIGHT" render scenes/refs/furnace-0.8.toml --backend "$BACKEND" --width 8 --height 8 --spp 1 \
+    -o "$out/probe.png" 2>&1 | sed -n 's/^\(backend\|adapter\): \(.*\)/\2/p')
+echo "$(date -u +%F), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(nproc) cores, pathlight: $device"
 echo "load: $(cut -d' ' -f1-3 /proc/loadavg) (a busy machine slows both sides)"
-echo "${RES}x${RES}, $SPP spp, $ROUNDS rounds"
+echo "${RES}x${RES}, $SPP spp, $ROUNDS rounds, Mitsuba $VARIANT"
 samples=$((RES * RES * SPP))
 
 median() { sort -g | sed -n "$(((ROUNDS + 1) / 2))p"; }
@@ -68,20 +82,26 @@ for scene in "${SCENES[@]}"; do
     pl_times=() mi_times=()
     for round in $(seq "$ROUNDS"); do
         start=$(date +%s.%N)
-        "$PATHLIGHT" render "scenes/refs/$scene.toml" --backend cpu --width "$RES" --height "$RES" \
+        "$PATHLIGHT" render "scenes/refs/$scene.toml" --backend "$BACKEND" --width "$RES" --height "$RES" \
             --spp "$SPP" -o "$out/pathlight.exr" 2>"$out/log" || { cat "$out/log"; exit 1; }
         end=$(date +%s.%N)
-        pl_times+=("$(awk "BEGIN { print $end - $start }")")
-        json=$("$VENV/bin/python" tools/mitsuba_refs.py time "$scene" --res "$RES" --spp "$SPP" \
-            --repeats 1 --save "$out/mitsuba.exr")
-        mi_times+=("$(echo "$json" | "$VENV/bin/python" -c 'import json,sys; print(json.load(sys.stdin)["median_seconds"])')")
+        if [ "$BACKEND" = cpu ]; then
+            pl_times+=("$(awk "BEGIN { print $end - $start }")")
+        else
+            pl_times+=("$(sed -n 's/.*render \([0-9.]*\) s.*/\1/p' "$out/log" | tail -1)")
+        fi
+        json=$("$PY" tools/mitsuba_refs.py time "$scene" --res "$RES" --spp "$SPP" \
+            --repeats 1 --save "$out/mitsuba.exr" --variant "$VARIANT")
+        mi_times+=("$(echo "$json" | "$PY" -c 'import json,sys; print(json.load(sys.stdin)["median_seconds"])')")
     done
+    echo "$scene: pathlight ${pl_times[*]} s, Mitsuba ${mi_times[*]} s" >&2
     pl=$(printf '%s\n' "${pl_times[@]}" | median)
     mi=$(printf '%s\n' "${mi_times[@]}" | median)
-    errors=$("$VENV/bin/python" tools/mitsuba_refs.py relmse-of "$scene" "$out/pathlight.exr" "$out/mitsuba.exr" |
-        "$VENV/bin/python" -c 'import json,sys; print(" ".join(str(json.loads(l)["relmse"]) for l in sys.stdin))')
+    errors=$("$PY" tools/mitsuba_refs.py relmse-of "$scene" "$out/pathlight.exr" "$out/mitsuba.exr" --variant "$VARIANT" |
+        "$PY" -c 'import json,sys; print(" ".join(str(json.loads(l)["relmse"]) for l in sys.stdin))')
     read -r pl_err mi_err <<<"$errors"
     awk -v s="$scene" -v n="$samples" -v p="$pl" -v m="$mi" -v pe="$pl_err" -v me="$mi_err" 'BEGIN {
         printf "%-26s %12.2f %12.2f %7.2f %10.5f %10.5f %8.2f\n", s, n / p / 1e6, n / m / 1e6, m / p, pe, me, (m * me) / (p * pe) }'
 done
+echo "(pathlight: whole process on the CPU backend, render alone on the GPU; Mitsuba: render alone)"
 echo "(pathlight and Mitsuba in M samples/s; ratio = pathlight / Mitsuba samples/s; to-error = Mitsuba's time to pathlight's at equal error)"

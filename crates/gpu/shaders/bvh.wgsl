@@ -80,7 +80,7 @@ fn intersect_shape(i: u32, o: Object, ray: Ray, hit: ptr<function, Hit>) {
 fn hit_triangle(object: u32, triangle: u32, v0: vec3f, v1: vec3f, v2: vec3f, ray: ShearedRay, hit: ptr<function, Hit>) {
     let r = intersect_triangle(v0, v1, v2, ray, (*hit).t);
     if r.x < (*hit).t
-        && ((objects[object].flags & FLAG_ALPHA) == 0u || alpha_stops(object, triangle, r.y, r.z, r.x)) {
+        && (!ALPHA || (objects[object].flags & FLAG_ALPHA) == 0u || alpha_stops(object, triangle, r.y, r.z, r.x)) {
         *hit = Hit(r.x, object, triangle, r.y, r.z);
     }
 }

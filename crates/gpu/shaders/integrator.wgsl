@@ -72,6 +72,9 @@ var<workgroup> workgroup_rays: atomic<u32>;
 var<workgroup> workgroup_dropped: atomic<u32>;
 // With `params.aovs`: one pixel per pixel of `accum` (else a placeholder).
 @group(1) @binding(3) var<storage, read_write> aov: array<AovPixel>;
+// Whether the render can ask for auxiliary images (a pipeline constant, the host's
+// `params.aovs != 0`): false compiles their bookkeeping out of the path loop.
+override AOVS: bool = true;
 
 const T_MAX: f32 = 1.0e30;
 
@@ -119,7 +122,7 @@ fn trace_path(first: Ray, sampler: ptr<function, Sampler>) -> PathResult {
     var radiance = vec3f(0.0);
     // The auxiliary images: still looking for their surface, the weight of the perfect
     // mirrors and glass passed through so far, what was found.
-    var aov_pending = params.aovs != 0u;
+    var aov_pending = AOVS && params.aovs != 0u;
     var aov_weight = vec3f(1.0);
     var albedo = vec3f(0.0);
     var normal = vec3f(0.0);
@@ -288,14 +291,14 @@ fn render(@builtin(global_invocation_id) gid: vec3u, @builtin(local_invocation_i
             } else {
                 samples_dropped++;
             }
-            if params.aovs != 0u {
+            if AOVS && params.aovs != 0u {
                 add_aov_sample(&aov_batch, path);
             }
         }
         var total = accum[pixel];
         add_fixed(&total, batch);
         accum[pixel] = total;
-        if params.aovs != 0u {
+        if AOVS && params.aovs != 0u {
             var albedo = aov[pixel].albedo;
             add_fixed(&albedo, aov_batch.albedo);
             var normal = aov[pixel].normal;

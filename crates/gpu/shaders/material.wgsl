@@ -1,7 +1,8 @@
 // A material at a surface point, and the one dispatch on its model: the common textures
 // (base colour, emission) applied here, the model's own texture step, BSDF evaluation and
 // sampling in the model's file (`lobes.wgsl`, `metal_rough.wgsl`). A new model adds a
-// MODEL_ constant and a case to each switch below (ARCHITECTURE.md, "How to add a material
+// MODEL_ constant and a branch to each dispatch below (each
+// compiled out when the scene has no material of the model: `METAL_ROUGH`) (ARCHITECTURE.md, "How to add a material
 // model"). CPU twin: `crates/cpu/src/material.rs`.
 
 #import scene
@@ -45,11 +46,8 @@ fn material_at(s: Surface) -> MaterialPoint {
     if has_texture(m, TEXTURE_BASE) {
         base_color *= srgb_to_linear(material_texture(m, TEXTURE_BASE, uv).rgb);
     }
-    switch m.model {
-        case MODEL_METAL_ROUGH: {
-            metal_rough_textured(&params, m, uv);
-        }
-        default: {}
+    if METAL_ROUGH && m.model == MODEL_METAL_ROUGH {
+        metal_rough_textured(&params, m, uv);
     }
     return MaterialPoint(m.model, base_color, emission_at(index, uv), params);
 }
@@ -68,67 +66,47 @@ fn emission_at(index: u32, uv: vec2f) -> vec3f {
 // `sample_material` produces wi.
 // CPU twin: `eval_material`.
 fn eval_material(p: MaterialPoint, s: Surface, wo: vec3f, wi: vec3f) -> BsdfEval {
-    switch p.model {
-        case MODEL_METAL_ROUGH: {
-            return eval_metal_rough(metal_rough_params(p.params), p.base_color, s, wo, wi);
-        }
-        default: {
-            return eval_lobes(lobes_params(p.params), p.base_color, s, wo, wi);
-        }
+    if METAL_ROUGH && p.model == MODEL_METAL_ROUGH {
+        return eval_metal_rough(metal_rough_params(p.params), p.base_color, s, wo, wi);
     }
+    return eval_lobes(lobes_params(p.params), p.base_color, s, wo, wi);
 }
 
 // A direction sampled from the BSDF.
 // CPU twin: `sample_material`.
 fn sample_material(p: MaterialPoint, s: Surface, wo: vec3f, u_lobe: f32, u_fresnel: f32, u: vec2f) -> BsdfSample {
-    switch p.model {
-        case MODEL_METAL_ROUGH: {
-            return sample_metal_rough(metal_rough_params(p.params), p.base_color, s, wo, u_lobe, u_fresnel, u);
-        }
-        default: {
-            return sample_lobes(lobes_params(p.params), p.base_color, s, wo, u_lobe, u_fresnel, u);
-        }
+    if METAL_ROUGH && p.model == MODEL_METAL_ROUGH {
+        return sample_metal_rough(metal_rough_params(p.params), p.base_color, s, wo, u_lobe, u_fresnel, u);
     }
+    return sample_lobes(lobes_params(p.params), p.base_color, s, wo, u_lobe, u_fresnel, u);
 }
 
 // The material's albedo for a denoiser's auxiliary image (the approximate colour of the
 // surface, independent of light and view; in [0, 1] for colours in [0, 1]).
 // CPU twin: `material_albedo`.
 fn material_albedo(p: MaterialPoint) -> vec3f {
-    switch p.model {
-        case MODEL_METAL_ROUGH: {
-            return metal_rough_albedo(metal_rough_params(p.params), p.base_color);
-        }
-        default: {
-            return lobes_albedo(lobes_params(p.params), p.base_color);
-        }
+    if METAL_ROUGH && p.model == MODEL_METAL_ROUGH {
+        return metal_rough_albedo(metal_rough_params(p.params), p.base_color);
     }
+    return lobes_albedo(lobes_params(p.params), p.base_color);
 }
 
 // What the inside of a solid material absorbs per unit length (zero for every other): a
 // path that reaches it from inside keeps exp(-absorption t) of its segment of length t.
 // CPU twin: `material_absorption`.
 fn material_absorption(p: MaterialPoint) -> vec3f {
-    switch p.model {
-        case MODEL_METAL_ROUGH: {
-            let m = metal_rough_params(p.params);
-            return select(m.attenuation, vec3f(0.0), m.thin);
-        }
-        default: {
-            return vec3f(0.0);
-        }
+    if METAL_ROUGH && p.model == MODEL_METAL_ROUGH {
+        let m = metal_rough_params(p.params);
+        return select(m.attenuation, vec3f(0.0), m.thin);
     }
+    return vec3f(0.0);
 }
 
 // Whether the BSDF has a non-delta lobe (next-event estimation is worth doing).
 // CPU twin: `has_continuous_material_lobe`.
 fn has_continuous_material_lobe(p: MaterialPoint) -> bool {
-    switch p.model {
-        case MODEL_METAL_ROUGH: {
-            return has_continuous_metal_rough(metal_rough_params(p.params), p.base_color);
-        }
-        default: {
-            return has_continuous_lobes(lobes_params(p.params));
-        }
+    if METAL_ROUGH && p.model == MODEL_METAL_ROUGH {
+        return has_continuous_metal_rough(metal_rough_params(p.params), p.base_color);
     }
+    return has_continuous_lobes(lobes_params(p.params));
 }

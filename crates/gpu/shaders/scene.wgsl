@@ -97,6 +97,18 @@ const INSTANCE: u32 = 0xfffffffeu;
 // halved the default scene's samples/s).
 override INSTANCES: bool = true;
 
+// What the scene's materials and objects use (pipeline constants, set by the host from the
+// scene, like INSTANCES): false compiles the feature's code out of the kernel, so a scene
+// without glTF materials, textures or alpha cut-outs does not pay for them in registers.
+// Metal-rough (glTF) materials.
+override METAL_ROUGH: bool = true;
+// Texture slots (colour, emission, normal maps, the model's own); see `has_texture`.
+override TEXTURES: bool = true;
+// Normal maps (TEXTURE_NORMAL, TEXTURE_COAT_NORMAL): the tangent frame in `surface_at`.
+override NORMAL_MAPS: bool = true;
+// Objects with alpha cut-outs (FLAG_ALPHA), tested in the walk.
+override ALPHA: bool = true;
+
 // The placement of an instance: rows of its affine transforms, each (x, y, z, translation).
 struct Instance {
     to_object: array<vec4f, 3>,

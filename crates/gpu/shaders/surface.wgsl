@@ -153,7 +153,7 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
             var tangent = vec3f(0.0);
             let wo = -ray.dir;
             let side = select(-1.0, 1.0, dot(wo, s.ng) >= 0.0);
-            if (m.texture_mask & ((1u << TEXTURE_NORMAL) | (1u << TEXTURE_COAT_NORMAL))) != 0u {
+            if NORMAL_MAPS && (m.texture_mask & ((1u << TEXTURE_NORMAL) | (1u << TEXTURE_COAT_NORMAL))) != 0u {
                 var t0 = decode_unit(v0.tangent);
                 var t1 = decode_unit(v1.tangent);
                 var t2 = decode_unit(v2.tangent);
@@ -166,7 +166,7 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
                 tangent = b0 * t0 + hit.b1 * t1 + hit.b2 * t2;
             }
             let sign = tangent_sign(v0.tangent) * select(1.0, -1.0, (o.flags & FLAG_MIRRORED) != 0u);
-            if has_texture(m, TEXTURE_NORMAL) {
+            if NORMAL_MAPS && has_texture(m, TEXTURE_NORMAL) {
                 s.ns = normal_mapped(m, TEXTURE_NORMAL, m.normal_scale, s.uv, s.ns, tangent, sign);
                 s.ns = side * valid_reflection_normal(side * s.ng, wo, side * s.ns);
             }
@@ -174,7 +174,7 @@ fn surface_at(hit: Hit, ray: Ray) -> Surface {
                 s.ns = -s.ns;
             }
             s.nc = s.ns;
-            if has_texture(m, TEXTURE_COAT_NORMAL) {
+            if NORMAL_MAPS && has_texture(m, TEXTURE_COAT_NORMAL) {
                 s.nc = normal_mapped(m, TEXTURE_COAT_NORMAL, m.coat_normal_scale, s.uv, interpolated, tangent, sign);
                 s.nc = side * valid_reflection_normal(side * s.ng, wo, side * s.nc);
                 if dot(s.nc, s.ng) < 0.0 {

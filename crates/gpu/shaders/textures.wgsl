@@ -59,7 +59,7 @@ fn sample_slot(slot: TextureSlot, uv: vec2f) -> vec4f {
 // Whether material `m` has its texture `which` (a TEXTURE_*).
 // CPU twin: `has_texture`.
 fn has_texture(m: Material, which: u32) -> bool {
-    return ((m.texture_mask >> which) & 1u) != 0u;
+    return TEXTURES && ((m.texture_mask >> which) & 1u) != 0u;
 }
 
 // Material `m`'s texture `which` (a TEXTURE_* it has) at `uv`.

@@ -6,7 +6,10 @@
 
 use std::time::{Duration, Instant};
 
-use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams};
+use pathlight_core::gpu_types::{
+    FLAG_ALPHA, GpuAccumPixel, GpuAovPixel, GpuRenderParams, TEXTURE_COAT_NORMAL, TEXTURE_NORMAL,
+};
+use pathlight_core::materials::MODEL_METAL_ROUGH;
 use pathlight_core::{
     Accumulation, Film, PreparedScene, RenderError, Renderer, SampleCursor, Shading,
 };
@@ -65,6 +68,67 @@ impl Accel {
     }
 }
 
+/// What a scene's integrator kernel compiles in: the pipeline constants of `scene.wgsl` that
+/// compile unused features out, so that a scene pays in registers only for what it uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct KernelFeatures {
+    /// Instances (`INSTANCES`).
+    instances: bool,
+    /// Metal-rough (glTF) materials (`METAL_ROUGH`).
+    metal_rough: bool,
+    /// Texture slots (`TEXTURES`).
+    textures: bool,
+    /// Normal maps (`NORMAL_MAPS`).
+    normal_maps: bool,
+    /// Objects with alpha cut-outs (`ALPHA`).
+    alpha: bool,
+    /// Auxiliary images (`AOVS` of `integrator.wgsl`).
+    aovs: bool,
+}
+
+impl KernelFeatures {
+    /// The features `scene` uses, rendered with auxiliary images or not (`aovs`).
+    fn of(scene: &PreparedScene, aovs: bool) -> Self {
+        Self {
+            instances: scene.geometry.has_instances(),
+            aovs,
+            ..Self::of_shading(&scene.shading)
+        }
+    }
+
+    /// The features materials and objects `shading` use (no instances, no auxiliary images).
+    fn of_shading(shading: &Shading) -> Self {
+        let objects = &shading.objects[..shading.object_count as usize];
+        Self {
+            instances: false,
+            metal_rough: shading
+                .materials
+                .iter()
+                .any(|m| m.model == MODEL_METAL_ROUGH),
+            textures: shading.materials.iter().any(|m| m.texture_mask != 0),
+            normal_maps: shading
+                .materials
+                .iter()
+                .any(|m| m.texture_mask & (1 << TEXTURE_NORMAL | 1 << TEXTURE_COAT_NORMAL) != 0),
+            alpha: objects.iter().any(|o| o.flags & FLAG_ALPHA != 0),
+            aovs: false,
+        }
+    }
+
+    /// The pipeline constants.
+    fn constants(self) -> [(&'static str, f64); 6] {
+        let value = |on: bool| f64::from(u8::from(on));
+        [
+            ("INSTANCES", value(self.instances)),
+            ("METAL_ROUGH", value(self.metal_rough)),
+            ("TEXTURES", value(self.textures)),
+            ("NORMAL_MAPS", value(self.normal_maps)),
+            ("ALPHA", value(self.alpha)),
+            ("AOVS", value(self.aovs)),
+        ]
+    }
+}
+
 /// A progressive render on a wgpu adapter: the scene on the device, the integrator
 /// pipeline and the accumulation buffer.
 #[derive(Debug)]
@@ -73,6 +137,10 @@ pub struct GpuRenderer {
     ctx: GpuContext,
     scene: SceneBuffers,
     pipeline: wgpu::ComputePipeline,
+    /// How the pipeline finds hits, and what it compiles in (rebuilt when new materials
+    /// change that).
+    accel: Accel,
+    features: KernelFeatures,
     params_buffer: wgpu::Buffer,
     accum_buffer: wgpu::Buffer,
     /// The auxiliary images' sums ([`GpuAovPixel`] per pixel), or a placeholder for a render
@@ -119,18 +187,12 @@ impl GpuRenderer {
                 storage_entry(3, false),
             ],
         });
-        let stack_size = scene
-            .geometry
-            .stack_bound
-            .next_multiple_of(8)
-            .min(MAX_STACK);
-        let pipeline = integrator_pipeline(
+        let stack_size = stack_size(scene);
+        let features = KernelFeatures::of(scene, settings.aovs);
+        let pipeline = IntegratorKernel::new(accel, stack_size, features)?.pipeline(
             device,
             &scene_buffers.layout,
             &frame_layout,
-            accel,
-            stack_size,
-            scene.geometry.has_instances(),
         )?;
         let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("render params"),
@@ -160,6 +222,8 @@ impl GpuRenderer {
             ctx: ctx.clone(),
             scene: scene_buffers,
             pipeline,
+            accel,
+            features,
             params_buffer,
             accum_buffer,
             aov_buffer,
@@ -323,8 +387,20 @@ impl Renderer for GpuRenderer {
         Ok(())
     }
 
-    /// Uploads the objects, materials and light table again; the BVH and the pipeline stay.
+    /// Uploads the objects, materials and light table again; the BVH stays, and so does the
+    /// pipeline unless the new materials use a feature it compiled out, or no longer use one
+    /// it compiled in.
     fn set_materials(&mut self, shading: &Shading) -> Result<(), RenderError> {
+        let features = KernelFeatures {
+            instances: self.features.instances,
+            aovs: self.features.aovs,
+            ..KernelFeatures::of_shading(shading)
+        };
+        if features != self.features {
+            self.pipeline = IntegratorKernel::new(self.accel, self.stack_size, features)?
+                .pipeline(&self.ctx.device, &self.scene.layout, &self.frame_layout)?;
+            self.features = features;
+        }
         self.scene.set_shading(&self.ctx.device, shading)?;
         self.params.set_shading(shading);
         self.restart();
@@ -525,32 +601,67 @@ fn frame_bind_group(
     bind_buffers(device, "frame", layout, &[params, accum, counters, aovs])
 }
 
-/// The integrator pipeline with the given scheme and traversal stack, its instance paths
-/// compiled in when the scene has `instances` (the `INSTANCES` constant of `scene.wgsl`).
-fn integrator_pipeline(
-    device: &wgpu::Device,
-    scene_layout: &wgpu::BindGroupLayout,
-    frame_layout: &wgpu::BindGroupLayout,
-    accel: Accel,
-    stack_size: u32,
-    instances: bool,
-) -> Result<wgpu::ComputePipeline, RenderError> {
-    let [accel_constant] = accel.pipeline_constants();
-    let constants = [
-        accel_constant,
-        ("INSTANCES", f64::from(u8::from(instances))),
-    ];
-    create_compute_pipeline(
-        device,
-        "integrator",
-        &wgsl::assemble("integrator", &[("STACK_SIZE", stack_size)]).map_err(|err| {
-            RenderError::Pipeline {
-                label: "integrator".into(),
-                message: err.to_string(),
-            }
-        })?,
-        "render",
-        &[scene_layout, frame_layout],
-        &constants,
-    )
+/// The integrator kernel of a scene: its WGSL, with the traversal stack sized to the scene's
+/// tree, and its pipeline constants (the hit-finding scheme, the features compiled in).
+/// `examples/kernel_stats.rs` compiles it as the renderer does.
+#[derive(Debug, Clone)]
+pub struct IntegratorKernel {
+    /// The assembled WGSL module; its entry point is `render`.
+    pub source: String,
+    /// Its pipeline-overridable constants by name.
+    pub constants: Vec<(&'static str, f64)>,
+}
+
+impl IntegratorKernel {
+    /// The kernel [`GpuRenderer::new`] compiles for `scene`, `settings` and `accel`.
+    pub fn of(
+        scene: &PreparedScene,
+        settings: &RenderSettings,
+        accel: Accel,
+    ) -> Result<Self, RenderError> {
+        Self::new(
+            accel,
+            stack_size(scene),
+            KernelFeatures::of(scene, settings.aovs),
+        )
+    }
+
+    fn new(accel: Accel, stack_size: u32, features: KernelFeatures) -> Result<Self, RenderError> {
+        let source =
+            wgsl::assemble("integrator", &[("STACK_SIZE", stack_size)]).map_err(|err| {
+                RenderError::Pipeline {
+                    label: "integrator".into(),
+                    message: err.to_string(),
+                }
+            })?;
+        let mut constants = accel.pipeline_constants().to_vec();
+        constants.extend(features.constants());
+        Ok(Self { source, constants })
+    }
+
+    fn pipeline(
+        &self,
+        device: &wgpu::Device,
+        scene_layout: &wgpu::BindGroupLayout,
+        frame_layout: &wgpu::BindGroupLayout,
+    ) -> Result<wgpu::ComputePipeline, RenderError> {
+        create_compute_pipeline(
+            device,
+            "integrator",
+            &self.source,
+            "render",
+            &[scene_layout, frame_layout],
+            &self.constants,
+        )
+    }
+}
+
+/// Entries of the traversal stack compiled for `scene`: its tree's bound, rounded up to 8, at
+/// most [`MAX_STACK`].
+fn stack_size(scene: &PreparedScene) -> u32 {
+    scene
+        .geometry
+        .stack_bound
+        .next_multiple_of(8)
+        .min(MAX_STACK)
 }

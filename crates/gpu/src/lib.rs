@@ -10,4 +10,4 @@ pub mod scene_buffers;
 pub mod wgsl;
 
 pub use context::GpuContext;
-pub use gpu_renderer::{Accel, GpuRenderer};
+pub use gpu_renderer::{Accel, GpuRenderer, IntegratorKernel};

@@ -7,7 +7,7 @@ use pathlight_core::Film;
 use crate::common::{context, gpu_renderer, render, render_cpu, render_to, repo, scene};
 use glam::Vec3;
 use pathlight_core::{PreparedScene, Renderer};
-use pathlight_scene::default_scene;
+use pathlight_scene::{MetalRough, Model, default_scene};
 
 /// Pixel coordinates `(x, y)`.
 type Pixels = Vec<(u32, u32)>;
@@ -276,8 +276,9 @@ fn batching_does_not_change_the_image() {
 /// The viewer's schedule: frames rendered band by band (`step_frame`, a tiny time target so
 /// every band is one workgroup of rows), and the other ways to add frames, give the same
 /// image; mid-frame, the rows already sampled are divided by their own count; after
-/// `set_camera` with a new size and camera, and after `set_materials` with a light
-/// toggled, the image is that of a fresh renderer.
+/// `set_camera` with a new size and camera, after `set_materials` with a light toggled, and
+/// after `set_materials` with a metal-rough material (a model the scene's kernel had compiled
+/// out, so the pipeline is built again), the image is that of a fresh renderer.
 #[test]
 fn frames_in_bands_and_scene_changes_keep_the_image_exact() {
     let s = scene("refs/cornell-spheres.toml", 24, 3, 4);
@@ -327,6 +328,20 @@ fn frames_in_bands_and_scene_changes_keep_the_image_exact() {
     assert!(shading.light_count > 1);
     r.set_materials(&shading).unwrap();
     assert_eq!(render_to(&mut r, 2), render(&lit));
+
+    // The glowing sphere turns gold metal-rough: a model no material of the scene had.
+    let mut gold = lit.clone();
+    let material = gold.objects[sphere].material as usize;
+    gold.materials[material].model = Model::MetalRough(MetalRough {
+        metallic: 1.0,
+        roughness: 0.3,
+        ..MetalRough::DEFAULT
+    });
+    let shading = PreparedScene::new(&s).unwrap().shading_of(&gold);
+    r.set_materials(&shading).unwrap();
+    let film = render_to(&mut r, 2);
+    assert_eq!(film, render(&gold));
+    assert_ne!(film, render(&lit));
 }
 
 /// Same seed, same image, bit for bit, however the work is batched; another seed differs.
