@@ -283,7 +283,7 @@ fn render_to_file(
         None => {}
     }
     note!(
-        "wrote {}: {width}x{height}, {spp} spp (samples {}..{}), render {:.2} s ({:.2} M \
+        "wrote {}: {width}x{height}, {spp} spp (samples {}..{}), render {:.3} s ({:.2} M \
          samples/s), total {:.2} s",
         args.output.display(),
         first_sample,
