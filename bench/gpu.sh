@@ -80,7 +80,10 @@ for round in $(seq "$ROUNDS"); do
                     rays=$(awk '$1 == "rays/s" { print $2 / 1000 }' "$log")
                     echo "${fps:-nan} ${rays:-nan}" >>"$out/$case.$i"
                 fi
-                [ "$round" = 1 ] && [ "$case" = "${CASE_LIST[0]}" ] && grep -m1 -E '^device|backend:' "$log" | sed "s/^/binary $i: /"
+                if [ "$round" = 1 ] && [ "$case" = "${CASE_LIST[0]}" ]; then
+                    grep -m1 -E '^device|backend:' "$log" | sed "s/^/binary $i: /"
+                    grep -q 'cpu backend' "$log" && echo "binary $i: warning: no hardware GPU, these are the CPU backend's figures"
+                fi
             else
                 echo "binary $i failed $case: $(tail -1 "$log")"
             fi
