@@ -23,7 +23,7 @@ use crate::bvh::{Entry, Hit, RayLanes, TOP_LEVEL, Walk};
 use crate::cpu_scene::CpuScene;
 use crate::intersect::{
     MISS, ROBUST_FAR, Ray, ShearedRay, intersect_cylinder, intersect_quad, intersect_sphere,
-    intersect_triangle, safe_inverse,
+    intersect_triangle,
 };
 use crate::textures::alpha_stops;
 
@@ -71,6 +71,9 @@ pub(crate) struct PacketRays {
 }
 
 impl PacketRays {
+    /// The packet's rays, their inverse directions and shears computed lane by lane side by
+    /// side (the values of [`crate::intersect::safe_inverse`] and [`ShearedRay::new`] bit for bit: the same
+    /// operations, the axis choices made with masks instead of indices).
     #[inline(always)]
     pub(crate) fn new(packet: &RayPacket) -> Self {
         let mut rays = Self {
@@ -80,16 +83,50 @@ impl PacketRays {
             shear: [[[0.0; PACKET]; 3]; 3],
         };
         for (l, ray) in packet.rays.iter().enumerate() {
-            let inv = safe_inverse(ray.dir);
-            let sheared = ShearedRay::new(ray);
-            let rows = [sheared.row_x, sheared.row_y, sheared.row_z];
             for axis in 0..3 {
                 rays.origin[axis][l] = ray.origin[axis];
                 rays.dir[axis][l] = ray.dir[axis];
-                rays.inv_dir[axis][l] = inv[axis];
-                for (row, r) in rows.iter().enumerate() {
-                    rays.shear[row][axis][l] = r[axis];
+            }
+        }
+        let tiny = 1e-20_f32;
+        for axis in 0..3 {
+            for l in 0..PACKET {
+                let c = rays.dir[axis][l];
+                let fixed = if c.abs() < tiny {
+                    if c >= 0.0 { tiny } else { -tiny }
+                } else {
+                    c
+                };
+                rays.inv_dir[axis][l] = 1.0 / fixed;
+            }
+        }
+        for l in 0..PACKET {
+            let [dx, dy, dz] = [rays.dir[0][l], rays.dir[1][l], rays.dir[2][l]];
+            let (ax, ay, az) = (dx.abs(), dy.abs(), dz.abs());
+            // kz: the largest axis (ties to the first, as `ShearedRay::new`); kx, ky the next.
+            let z_is = {
+                let x = ax >= ay && ax >= az;
+                let y = !x && ay >= az;
+                [x, y, !x && !y]
+            };
+            let pick = |k: [bool; 3]| {
+                if k[0] {
+                    dx
+                } else if k[1] {
+                    dy
+                } else {
+                    dz
                 }
+            };
+            let x_is = [z_is[2], z_is[0], z_is[1]];
+            let y_is = [z_is[1], z_is[2], z_is[0]];
+            let (d_kx, d_ky, d_kz) = (pick(x_is), pick(y_is), pick(z_is));
+            let (shear_x, shear_y, scale_z) = (-d_kx / d_kz, -d_ky / d_kz, 1.0 / d_kz);
+            for axis in 0..3 {
+                let on_z = |value: f32| if z_is[axis] { value } else { 0.0 };
+                rays.shear[0][axis][l] = if x_is[axis] { 1.0 } else { on_z(shear_x) };
+                rays.shear[1][axis][l] = if y_is[axis] { 1.0 } else { on_z(shear_y) };
+                rays.shear[2][axis][l] = on_z(scale_z);
             }
         }
         rays
@@ -550,6 +587,55 @@ mod tests {
     use crate::intersect::Ray;
     use crate::tracer::Tracer;
     use pathlight_scene::testing::flattened;
+
+    /// A packet's lane-wise inverse directions and shears are those of `safe_inverse` and
+    /// `ShearedRay::new` ray by ray, bit for bit: directions with ties between their largest
+    /// axes, zero and tiny components of both signs, and random ones.
+    #[test]
+    fn packet_rays_are_the_single_rays_bit_for_bit() {
+        use crate::intersect::{ShearedRay, safe_inverse};
+        let mut rng = StdRng::seed_from_u64(7);
+        let mut dirs = vec![
+            Vec3::new(1.0, 1.0, 1.0),
+            Vec3::new(-1.0, 1.0, 0.0),
+            Vec3::new(0.0, -2.0, 2.0),
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(-0.0, 1e-30, -1.0),
+            Vec3::new(3.0, -3.0, -3.0),
+            Vec3::new(1e-21, -1e-21, 0.5),
+        ];
+        while dirs.len() < 3 * PACKET {
+            dirs.push(random_ray(&mut rng, 2.0).dir);
+        }
+        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+        for chunk in dirs.chunks(PACKET) {
+            let mut packet = RayPacket::default();
+            for (l, dir) in chunk.iter().enumerate() {
+                packet.rays[l] = Ray {
+                    origin: Vec3::new(l as f32, -1.0, 2.0),
+                    dir: *dir,
+                };
+            }
+            let lanes = super::PacketRays::new(&packet);
+            for (l, ray) in packet.rays.iter().enumerate() {
+                let inv = Vec3::new(
+                    lanes.inv_dir[0][l],
+                    lanes.inv_dir[1][l],
+                    lanes.inv_dir[2][l],
+                );
+                assert_eq!(bits(inv), bits(safe_inverse(ray.dir)), "lane {l}: {ray:?}");
+                let (packed, alone) = (lanes.sheared(l), ShearedRay::new(ray));
+                for (a, b) in [
+                    (packed.row_x, alone.row_x),
+                    (packed.row_y, alone.row_y),
+                    (packed.row_z, alone.row_z),
+                    (packed.origin, alone.origin),
+                ] {
+                    assert_eq!(bits(a), bits(b), "lane {l}: {ray:?}");
+                }
+            }
+        }
+    }
 
     /// Each ray traced in a packet with others of `rays`, at a lane that depends on the ray,
     /// gets brute force's answer. Every other packet holds the ray alone (it walks alone from

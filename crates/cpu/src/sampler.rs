@@ -81,6 +81,9 @@ pub enum Draw {
 
 /// Most dimensions [`Sampler::next_batch`] draws at once: the lanes it computes.
 const LANES: usize = 8;
+/// Dimensions a bounce of the integrator draws in one batch (`Path::step`): a window of
+/// [`LANES`] values is computed anew when what is left of it cannot serve that many.
+const BOUNCE_DIMENSIONS: usize = 6;
 
 /// The sample values of one path. Twin of WGSL `Sampler`.
 #[derive(Debug, Clone)]
@@ -92,8 +95,8 @@ pub struct Sampler {
     dimension: u32,
     rng_state: u32,
     /// Sobol: the values of the [`LANES`] dimensions from `ahead_from` (both coordinates),
-    /// computed one batch ahead of their use so that their hash chains' latency overlaps
-    /// the shading that comes between.
+    /// the window [`Sampler::next_batch`] serves from, computed ahead of their use so that
+    /// their hash chains' latency overlaps the shading that comes between.
     ahead: [Vec2; LANES],
     /// The first dimension in `ahead`; `u32::MAX` before the first batch.
     ahead_from: u32,
@@ -142,10 +145,11 @@ impl Sampler {
     /// Owen-scrambled shuffled index (dimension 0, the van der Corput sequence, is the index
     /// reversed; dimension 1 is `sobol_1_reversed` of it), each scramble seeded by hashing
     /// the pixel and dimension. The dimensions' hash chains are independent, so they run
-    /// side by side in SIMD lanes (a third of a cornell-spheres frame's sampling time), and
-    /// each batch computes the next one's values too, to be taken when asked for: their
-    /// latency then overlaps the shading in between (+1-2%; a path computes one batch it
-    /// never uses). The WGSL draws them one by one.
+    /// [`LANES`] at a time side by side in SIMD lanes, into a window of values that serves
+    /// the requests in turn: the camera's one or two dimensions and the first bounce's six
+    /// come from one window. When what is left of the window cannot serve a bounce, the next
+    /// window is computed at once, ahead of its use, so that its latency overlaps the
+    /// shading in between. The WGSL draws them one by one.
     #[inline(always)]
     pub fn next_batch<const N: usize>(&mut self, draws: [Draw; N]) -> [Vec2; N] {
         const { assert!(N <= LANES) };
@@ -161,19 +165,24 @@ impl Sampler {
             }
             return out;
         }
-        if self.ahead_from != self.dimension {
-            // The first batch: nothing was computed ahead yet.
+        let mut offset = self.dimension.wrapping_sub(self.ahead_from) as usize;
+        if self.ahead_from == u32::MAX || offset + N > LANES {
+            // Not in the window (the first request, or a larger batch than a bounce's).
             self.ahead = self.sobol_lanes(self.dimension);
+            self.ahead_from = self.dimension;
+            offset = 0;
         }
         for i in 0..N {
-            out[i].x = self.ahead[i].x;
+            out[i].x = self.ahead[offset + i].x;
             if draws[i] == Draw::Two {
-                out[i].y = self.ahead[i].y;
+                out[i].y = self.ahead[offset + i].y;
             }
         }
         self.dimension += N as u32;
-        self.ahead = self.sobol_lanes(self.dimension);
-        self.ahead_from = self.dimension;
+        if offset + N + BOUNCE_DIMENSIONS > LANES {
+            self.ahead = self.sobol_lanes(self.dimension);
+            self.ahead_from = self.dimension;
+        }
         out
     }
 
