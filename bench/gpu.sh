@@ -17,7 +17,9 @@
 # median over the rounds with the range beside it. A case a binary cannot run prints "-".
 #
 #   bash bench/gpu.sh [--rounds N] [--frames N] [--cases LIST] [BIN...]
-#     BIN: pathlight binaries (default: a fresh release build); --rounds 2; --frames 3000
+#     BIN: pathlight binaries (default: a fresh release build), each optionally with options
+#     for all its runs in the same word, e.g. "target/release/pathlight --gpu-kernel
+#     wavefront" beside "target/release/pathlight"; --rounds 2; --frames 3000
 #     (the 500x500 cases; 1080p takes a tenth, 1m-triangles a third); --cases: a
 #     comma-separated subset of the names above.
 set -uo pipefail
@@ -61,7 +63,8 @@ args_of() {
 
 echo "$(date -u +%F), $(nvidia-smi --query-gpu=name,driver_version --format=csv,noheader 2>/dev/null || echo 'no nvidia-smi'), $(nproc) cores"
 for i in "${!BINS[@]}"; do
-    echo "binary $i: ${BINS[$i]} ($("${BINS[$i]}" --version 2>&1))"
+    read -r -a cmd <<<"${BINS[$i]}"
+    echo "binary $i: ${BINS[$i]} ($("${cmd[0]}" --version 2>&1))"
 done
 
 for round in $(seq "$ROUNDS"); do
@@ -70,7 +73,8 @@ for round in $(seq "$ROUNDS"); do
         for i in "${!BINS[@]}"; do
             log="$out/log"
             start=$(date +%s.%N)
-            if timeout 120 "${BINS[$i]}" "${args[@]}" >"$log" 2>&1; then
+            read -r -a cmd <<<"${BINS[$i]}"
+            if timeout 120 "${cmd[0]}" "${args[@]}" "${cmd[@]:1}" >"$log" 2>&1; then
                 end=$(date +%s.%N)
                 if [ "$case" = cornell-512 ]; then
                     render=$(sed -n 's/.*render \([0-9.]*\) s.*/\1/p' "$log" | tail -1)

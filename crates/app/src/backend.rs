@@ -8,7 +8,7 @@ use glam::Vec3;
 use pathlight_core::{PreparedScene, Renderer};
 use pathlight_cpu::{CpuRenderer, InstructionSet};
 use pathlight_gpu::context::{AutoChoice, auto_choice, available_adapters, describe};
-use pathlight_gpu::{Accel, GpuContext, GpuRenderer};
+use pathlight_gpu::{Accel, GpuContext, GpuRenderer, Kernel};
 use pathlight_scene::settings::{
     check_aperture, check_env_rotation, check_env_strength, check_length, check_max_depth,
     check_resolution,
@@ -214,20 +214,29 @@ impl Device {
     }
 
     /// A progressive render of `prepared` (the scene `scene` prepared) on this device,
-    /// finding hits with `accel` (the GPU offers the seed's slower schemes too).
+    /// finding hits with `accel` (the GPU offers the seed's slower schemes too) and, on the
+    /// GPU, running the integrator as `kernel`.
     pub fn renderer(
         &self,
         scene: &Scene,
         prepared: &PreparedScene,
         accel: Accel,
+        kernel: Kernel,
     ) -> anyhow::Result<Box<dyn Renderer>> {
         let (camera, settings) = (&scene.camera, &scene.settings);
         Ok(match self {
-            Device::Gpu(ctx) => Box::new(GpuRenderer::new(ctx, prepared, camera, settings, accel)?),
+            Device::Gpu(ctx) => {
+                let mut renderer = GpuRenderer::new(ctx, prepared, camera, settings, accel)?;
+                renderer.set_kernel(kernel)?;
+                Box::new(renderer)
+            }
             Device::Cpu if accel != Accel::Bvh => anyhow::bail!(
                 "--accel {} needs the GPU backend; the CPU backend has only the BVH",
                 accel.name()
             ),
+            Device::Cpu if kernel != Kernel::Megakernel => {
+                anyhow::bail!("--gpu-kernel {} needs the GPU backend", kernel.name())
+            }
             Device::Cpu => Box::new(cpu_renderer(scene, prepared)?),
         })
     }

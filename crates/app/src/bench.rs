@@ -30,6 +30,8 @@ struct Measurement {
     /// Column label in the seed table, or the scheme's name.
     label: String,
     accel: String,
+    /// How the GPU integrator is split into kernels (`megakernel` on the CPU backend too).
+    gpu_kernel: String,
     without: Vec<String>,
     width: u32,
     height: u32,
@@ -147,7 +149,7 @@ fn measure(
     let prepared = PreparedScene::new(scene)?;
     let bvh_build_s = build_start.elapsed().as_secs_f64();
     let triangles = prepared.geometry.triangle_count();
-    let mut renderer = device.renderer(scene, &prepared, accel)?;
+    let mut renderer = device.renderer(scene, &prepared, accel, args.gpu_kernel.into())?;
     let traversal_stack = renderer.traversal_stack();
     let time_limit = args.time_limit;
 
@@ -188,6 +190,7 @@ fn measure(
     Ok(Measurement {
         label: String::new(),
         accel: accel.name().into(),
+        gpu_kernel: pathlight_gpu::Kernel::from(args.gpu_kernel).name().into(),
         without: Vec::new(),
         width,
         height,
@@ -217,8 +220,8 @@ fn print_single(report: &Report) {
     println!("scene        {}{without}", report.scene);
     println!("device       {}", report.device_line());
     println!(
-        "settings     {}x{}, max_depth {}, 1 spp per frame, accel {}",
-        m.width, m.height, m.max_depth, m.accel
+        "settings     {}x{}, max_depth {}, 1 spp per frame, accel {}, {}",
+        m.width, m.height, m.max_depth, m.accel, m.gpu_kernel
     );
     println!(
         "frames       {} timed in {:.3} s after {} warm-up",

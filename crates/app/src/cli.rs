@@ -166,6 +166,9 @@ pub struct RenderArgs {
     pub spp: Option<u32>,
     #[command(flatten)]
     pub device: DeviceArgs,
+    /// How the integrator is split into kernels (GPU backend); the image is the same.
+    #[arg(long, value_enum, default_value_t = GpuKernelArg::Megakernel)]
+    pub gpu_kernel: GpuKernelArg,
     /// List the adapters found and exit.
     #[arg(long)]
     pub list_adapters: bool,
@@ -269,6 +272,26 @@ impl From<AccelArg> for pathlight_gpu::Accel {
     }
 }
 
+/// How the GPU backend splits the integrator into kernels (`--gpu-kernel`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum GpuKernelArg {
+    /// One kernel follows each path from the camera to its end.
+    Megakernel,
+    /// Kernels over queues of paths, one segment of every path at a time: faster on large
+    /// images (1920x1080 and up) on a discrete GPU and on lavapipe, slower on small images
+    /// of deep paths (BENCHMARKS.md, "The wavefront split").
+    Wavefront,
+}
+
+impl From<GpuKernelArg> for pathlight_gpu::Kernel {
+    fn from(arg: GpuKernelArg) -> Self {
+        match arg {
+            GpuKernelArg::Megakernel => Self::Megakernel,
+            GpuKernelArg::Wavefront => Self::Wavefront,
+        }
+    }
+}
+
 /// Options of `pathlight bench`.
 #[derive(Debug, clap::Args)]
 pub struct BenchArgs {
@@ -289,6 +312,9 @@ pub struct BenchArgs {
     /// How the nearest hit is found (GPU backend).
     #[arg(long, value_enum, default_value_t = AccelArg::Bvh)]
     pub accel: AccelArg,
+    /// How the integrator is split into kernels (GPU backend); the image is the same.
+    #[arg(long, value_enum, default_value_t = GpuKernelArg::Megakernel)]
+    pub gpu_kernel: GpuKernelArg,
     /// Leave out the object of this name (repeatable), e.g. `--without vase`.
     #[arg(long, value_name = "NAME")]
     pub without: Vec<String>,

@@ -189,7 +189,7 @@ fn render_to_file(
         accumulation,
     } = start(scene, args, &fingerprint)?;
     let device = Device::open(&args.device)?;
-    let mut renderer = device.renderer(scene, &prepared, Accel::Bvh)?;
+    let mut renderer = device.renderer(scene, &prepared, Accel::Bvh, args.gpu_kernel.into())?;
     let kind = match device {
         Device::Gpu(_) => "adapter",
         Device::Cpu => "backend",

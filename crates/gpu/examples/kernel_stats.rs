@@ -1,4 +1,4 @@
-//! Prints what each Vulkan device's driver reports of the integrator kernel it compiles for a
+//! Prints what each Vulkan device's driver reports of the integrator kernels it compiles for a
 //! scene (VK_KHR_pipeline_executable_properties): registers, spills, local memory, instruction
 //! counts, as the driver names them. On a GPU the registers a thread needs decide how many
 //! threads an SM keeps in flight, which hides the walk's memory latency.
@@ -7,11 +7,12 @@
 //! pipeline constants), translated to SPIR-V by naga as wgpu does, and compiled in a bare
 //! Vulkan pipeline that asks the driver for its statistics.
 //!
-//!   cargo run --release -p pathlight-gpu --example kernel_stats -- [--all] [SCENE]
+//!   cargo run --release -p pathlight-gpu --example kernel_stats -- [--all] [--wavefront] [SCENE]
 //!
 //! SCENE: a scene file (TOML or glTF); the built-in default scene when absent. `--all`
 //! compiles every feature in (instances, glTF materials, textures, normal maps, alpha,
-//! auxiliary images), as a scene that uses them all gets it.
+//! auxiliary images), as a scene that uses them all gets it. `--wavefront`: the wavefront's
+//! kernels (`--gpu-kernel wavefront`), each entry point in turn, instead of the megakernel.
 
 use std::ffi::CStr;
 use std::path::Path;
@@ -21,21 +22,29 @@ use ash::vk;
 use naga::back::{PipelineConstants, spv};
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use pathlight_core::PreparedScene;
-use pathlight_gpu::{Accel, IntegratorKernel};
+use pathlight_gpu::{Accel, IntegratorKernel, Kernel};
 use pathlight_scene::{default_scene, load_scene_file};
 
 fn main() -> Result<()> {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
-    let all = args.first().is_some_and(|a| a == "--all");
-    if all {
-        args.remove(0);
-    }
+    let all = args.iter().any(|a| a == "--all");
+    let wavefront = args.iter().any(|a| a == "--wavefront");
+    args.retain(|a| !a.starts_with("--"));
     let scene = match args.first() {
         Some(path) => load_scene_file(Path::new(path))?,
         None => default_scene::load()?,
     };
-    let mut kernel =
-        IntegratorKernel::of(&PreparedScene::new(&scene)?, &scene.settings, Accel::Bvh)?;
+    let split = if wavefront {
+        Kernel::Wavefront
+    } else {
+        Kernel::Megakernel
+    };
+    let mut kernel = IntegratorKernel::of(
+        &PreparedScene::new(&scene)?,
+        &scene.settings,
+        Accel::Bvh,
+        split,
+    )?;
     if all {
         for (name, value) in &mut kernel.constants {
             if *name != "ACCEL" {
@@ -44,7 +53,18 @@ fn main() -> Result<()> {
         }
     }
     println!("pipeline constants: {:?}", kernel.constants);
-    let (words, bindings) = spirv(&kernel)?;
+    for entry_point in kernel.entry_points {
+        println!("\n== entry point {entry_point}");
+        report_entry(&kernel, entry_point)?;
+    }
+    Ok(())
+}
+
+/// Compiles entry point `entry_point` of `kernel` on every Vulkan device and prints what each
+/// driver reports.
+fn report_entry(kernel: &IntegratorKernel, entry_point: &str) -> Result<()> {
+    let (words, bindings) = spirv(kernel, entry_point)?;
+    let entry_name = std::ffi::CString::new(entry_point)?;
     // SAFETY: the Vulkan loader is a system library; nothing else in this process uses it.
     let entry = unsafe { ash::Entry::load() }.context("no Vulkan loader")?;
     let app = vk::ApplicationInfo::default().api_version(vk::API_VERSION_1_2);
@@ -63,7 +83,7 @@ fn main() -> Result<()> {
                 .device_name_as_c_str()?
                 .to_owned();
             println!("\n{}", name.to_string_lossy());
-            if let Err(err) = report(&instance, physical, &words, &bindings) {
+            if let Err(err) = report(&instance, physical, &words, &bindings, &entry_name) {
                 println!("  no statistics: {err:#}");
             }
         }
@@ -76,14 +96,14 @@ fn main() -> Result<()> {
 type Binding = (u32, u32);
 
 /// The kernel's SPIR-V with its pipeline constants applied, and its storage buffers.
-fn spirv(kernel: &IntegratorKernel) -> Result<(Vec<u32>, Vec<Binding>)> {
+fn spirv(kernel: &IntegratorKernel, entry_point: &str) -> Result<(Vec<u32>, Vec<Binding>)> {
     let module = naga::front::wgsl::parse_str(&kernel.source)?;
     let info = Validator::new(ValidationFlags::all(), Capabilities::all()).validate(&module)?;
     let mut constants = PipelineConstants::default();
     for (name, value) in &kernel.constants {
         constants.insert((*name).to_owned(), *value);
     }
-    let entry = (naga::ShaderStage::Compute, "render");
+    let entry = (naga::ShaderStage::Compute, entry_point);
     let (module, info) =
         naga::back::pipeline_constants::process_overrides(&module, &info, Some(entry), &constants)?;
     let pipeline = spv::PipelineOptions {
@@ -114,6 +134,7 @@ unsafe fn report(
     physical: vk::PhysicalDevice,
     words: &[u32],
     bindings: &[Binding],
+    name: &CStr,
 ) -> Result<()> {
     let extension = ash::khr::pipeline_executable_properties::NAME;
     // SAFETY: valid handles (the caller's contract); every object made here is destroyed
@@ -147,7 +168,7 @@ unsafe fn report(
                 .push_next(&mut executable_info),
             None,
         )?;
-        let result = compile_and_print(instance, &device, words, bindings);
+        let result = compile_and_print(instance, &device, words, bindings, name);
         device.destroy_device(None);
         result
     }
@@ -162,6 +183,7 @@ unsafe fn compile_and_print(
     device: &ash::Device,
     words: &[u32],
     bindings: &[Binding],
+    name: &CStr,
 ) -> Result<()> {
     // SAFETY: the caller's contract; every object made here is destroyed before returning.
     unsafe {
@@ -193,7 +215,7 @@ unsafe fn compile_and_print(
         let stage = vk::PipelineShaderStageCreateInfo::default()
             .stage(vk::ShaderStageFlags::COMPUTE)
             .module(shader)
-            .name(c"render");
+            .name(name);
         let create = vk::ComputePipelineCreateInfo::default()
             .stage(stage)
             .layout(layout)

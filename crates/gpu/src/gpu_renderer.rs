@@ -18,6 +18,7 @@ use pathlight_scene::{Camera, RenderSettings};
 use crate::context::{GpuContext, describe};
 use crate::pipeline::{bind_buffers, create_compute_pipeline, storage_entry};
 use crate::scene_buffers::SceneBuffers;
+use crate::wavefront::{WAVEFRONT_ENTRY_POINTS, Wavefront};
 use crate::wgsl;
 
 /// Aimed-for GPU time of one submission.
@@ -65,6 +66,28 @@ impl Accel {
             Accel::BruteForce => 2.0,
         };
         [("ACCEL", value)]
+    }
+}
+
+/// How the integrator is split into kernels. Both give the same image bit for bit (a test
+/// checks it); which is faster depends on the device and the image (BENCHMARKS.md, "The
+/// wavefront split").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Kernel {
+    /// One kernel follows each path from the camera to its end (`integrator.wgsl`).
+    #[default]
+    Megakernel,
+    /// Kernels over queues of paths, one segment of every path at a time (`wavefront.wgsl`).
+    Wavefront,
+}
+
+impl Kernel {
+    /// Its name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kernel::Megakernel => "megakernel",
+            Kernel::Wavefront => "wavefront",
+        }
     }
 }
 
@@ -161,6 +184,8 @@ pub struct GpuRenderer {
     batch_samples: u32,
     /// Whether the piece size follows the measured speed (see [`Self::set_piece`]).
     adaptive: bool,
+    /// The wavefront kernels, when they render instead of `pipeline`.
+    wavefront: Option<Wavefront>,
 }
 
 impl GpuRenderer {
@@ -189,11 +214,8 @@ impl GpuRenderer {
         });
         let stack_size = stack_size(scene);
         let features = KernelFeatures::of(scene, settings.aovs);
-        let pipeline = IntegratorKernel::new(accel, stack_size, features)?.pipeline(
-            device,
-            &scene_buffers.layout,
-            &frame_layout,
-        )?;
+        let pipeline = IntegratorKernel::new(Kernel::Megakernel, accel, stack_size, features)?
+            .pipeline(device, &scene_buffers.layout, &frame_layout)?;
         let params_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("render params"),
             size: size_of::<GpuRenderParams>() as u64,
@@ -236,6 +258,7 @@ impl GpuRenderer {
             adaptive: true,
             params,
             cursor: SampleCursor::default(),
+            wavefront: None,
         })
     }
 
@@ -246,6 +269,34 @@ impl GpuRenderer {
         self.rows_per_dispatch = rows.clamp(1, self.params.height);
         self.batch_samples = samples.clamp(1, MAX_BATCH_SAMPLES);
         self.adaptive = false;
+    }
+
+    /// Renders with `kernel` from now on (the image does not depend on it).
+    pub fn set_kernel(&mut self, kernel: Kernel) -> Result<(), RenderError> {
+        self.wavefront = match kernel {
+            Kernel::Megakernel => None,
+            Kernel::Wavefront => Some(self.wavefront_kernels()?),
+        };
+        Ok(())
+    }
+
+    /// The wavefront kernels for the scene, the features and the image size.
+    fn wavefront_kernels(&self) -> Result<Wavefront, RenderError> {
+        let kernel = IntegratorKernel::new(
+            Kernel::Wavefront,
+            self.accel,
+            self.stack_size,
+            self.features,
+        )?;
+        let pixels = u64::from(self.params.width) * u64::from(self.params.height);
+        Wavefront::new(
+            &self.ctx.device,
+            &kernel,
+            &self.scene.layout,
+            &self.frame_layout,
+            pixels,
+            self.features.aovs,
+        )
     }
 
     /// The samples the accumulation buffer holds (see [`Renderer::step_frame`]).
@@ -285,7 +336,18 @@ impl GpuRenderer {
             .queue
             .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-        {
+        if let Some(wavefront) = &self.wavefront {
+            wavefront.record(
+                &self.ctx.queue,
+                &mut encoder,
+                &self.scene.bind_group,
+                &self.frame_bind_group,
+                self.params.width,
+                rows,
+                samples,
+                self.params.max_depth,
+            );
+        } else {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("integrator"),
                 timestamp_writes: None,
@@ -382,6 +444,9 @@ impl Renderer for GpuRenderer {
             );
             self.rows_per_dispatch = camera.height.min(WORKGROUP * 4);
             self.batch_samples = 1;
+            if self.wavefront.is_some() {
+                self.wavefront = Some(self.wavefront_kernels()?);
+            }
         }
         self.restart();
         Ok(())
@@ -397,9 +462,13 @@ impl Renderer for GpuRenderer {
             ..KernelFeatures::of_shading(shading)
         };
         if features != self.features {
-            self.pipeline = IntegratorKernel::new(self.accel, self.stack_size, features)?
-                .pipeline(&self.ctx.device, &self.scene.layout, &self.frame_layout)?;
+            self.pipeline =
+                IntegratorKernel::new(Kernel::Megakernel, self.accel, self.stack_size, features)?
+                    .pipeline(&self.ctx.device, &self.scene.layout, &self.frame_layout)?;
             self.features = features;
+            if self.wavefront.is_some() {
+                self.wavefront = Some(self.wavefront_kernels()?);
+            }
         }
         self.scene.set_shading(&self.ctx.device, shading)?;
         self.params.set_shading(shading);
@@ -601,42 +670,59 @@ fn frame_bind_group(
     bind_buffers(device, "frame", layout, &[params, accum, counters, aovs])
 }
 
-/// The integrator kernel of a scene: its WGSL, with the traversal stack sized to the scene's
-/// tree, and its pipeline constants (the hit-finding scheme, the features compiled in).
+/// The integrator kernels of a scene: their WGSL module, with the traversal stack sized to the
+/// scene's tree, its pipeline constants (the hit-finding scheme, the features compiled in)
+/// and its entry points.
 /// `examples/kernel_stats.rs` compiles it as the renderer does.
 #[derive(Debug, Clone)]
 pub struct IntegratorKernel {
-    /// The assembled WGSL module; its entry point is `render`.
+    /// The assembled WGSL module.
     pub source: String,
     /// Its pipeline-overridable constants by name.
     pub constants: Vec<(&'static str, f64)>,
+    /// Its entry points: `render` (the megakernel), or the wavefront's kernels.
+    pub entry_points: &'static [&'static str],
 }
 
 impl IntegratorKernel {
-    /// The kernel [`GpuRenderer::new`] compiles for `scene`, `settings` and `accel`.
+    /// The kernels the renderer compiles as `kernel` for `scene`, `settings` and `accel`.
     pub fn of(
         scene: &PreparedScene,
         settings: &RenderSettings,
         accel: Accel,
+        kernel: Kernel,
     ) -> Result<Self, RenderError> {
         Self::new(
+            kernel,
             accel,
             stack_size(scene),
             KernelFeatures::of(scene, settings.aovs),
         )
     }
 
-    fn new(accel: Accel, stack_size: u32, features: KernelFeatures) -> Result<Self, RenderError> {
-        let source =
-            wgsl::assemble("integrator", &[("STACK_SIZE", stack_size)]).map_err(|err| {
-                RenderError::Pipeline {
-                    label: "integrator".into(),
-                    message: err.to_string(),
-                }
-            })?;
+    fn new(
+        kernel: Kernel,
+        accel: Accel,
+        stack_size: u32,
+        features: KernelFeatures,
+    ) -> Result<Self, RenderError> {
+        let (module, entry_points) = match kernel {
+            Kernel::Megakernel => ("integrator", &["render"][..]),
+            Kernel::Wavefront => ("wavefront", &WAVEFRONT_ENTRY_POINTS[..]),
+        };
+        let source = wgsl::assemble(module, &[("STACK_SIZE", stack_size)]).map_err(|err| {
+            RenderError::Pipeline {
+                label: module.into(),
+                message: err.to_string(),
+            }
+        })?;
         let mut constants = accel.pipeline_constants().to_vec();
         constants.extend(features.constants());
-        Ok(Self { source, constants })
+        Ok(Self {
+            source,
+            constants,
+            entry_points,
+        })
     }
 
     fn pipeline(

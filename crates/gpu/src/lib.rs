@@ -7,7 +7,8 @@ pub mod display;
 pub mod gpu_renderer;
 pub mod pipeline;
 pub mod scene_buffers;
+pub mod wavefront;
 pub mod wgsl;
 
 pub use context::GpuContext;
-pub use gpu_renderer::{Accel, GpuRenderer, IntegratorKernel};
+pub use gpu_renderer::{Accel, GpuRenderer, IntegratorKernel, Kernel};

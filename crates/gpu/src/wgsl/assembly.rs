@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 
 /// The modules the renderer compiles: the path tracer (entry point `render`) and the
 /// viewer's display pass.
-pub const MODULES: [&str; 2] = ["integrator", "display"];
+pub const MODULES: [&str; 3] = ["integrator", "wavefront", "display"];
 
 /// Values of every `#const` for checking the files and modules at build time (the traversal
 /// stack of `bvh.wgsl`: 64 entries; a scene gets its own bound).

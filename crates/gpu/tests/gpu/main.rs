@@ -9,3 +9,4 @@ mod render;
 mod state;
 mod trace;
 mod twin;
+mod wavefront;

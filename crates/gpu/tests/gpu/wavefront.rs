@@ -1,0 +1,110 @@
+//! The wavefront kernels against the megakernel: the same sums bit for bit (radiance and
+//! auxiliary images), the same ray and dropped-sample counts, whatever the scene's features,
+//! the path length, and however the work is cut into bands of rows and batches of samples.
+
+use pathlight_core::{Accumulation, PreparedScene, Renderer};
+use pathlight_gpu::{Accel, GpuRenderer, Kernel};
+use pathlight_scene::Scene;
+
+use crate::common::{context, repo, scene};
+
+/// What a render leaves: the exact sums, and the rays traced and samples dropped.
+struct Outcome {
+    accumulation: Accumulation,
+    rays: u64,
+    dropped: u64,
+}
+
+/// Renders `scene` to `spp` with `kernel`, `rows` rows and `samples` samples per dispatch.
+fn render(scene: &Scene, kernel: Kernel, spp: u32, rows: u32, samples: u32) -> Outcome {
+    let prepared = PreparedScene::new(scene).unwrap();
+    let mut renderer = GpuRenderer::new(
+        context(),
+        &prepared,
+        &scene.camera,
+        &scene.settings,
+        Accel::Bvh,
+    )
+    .unwrap();
+    renderer.set_kernel(kernel).unwrap();
+    renderer.set_piece(rows, samples);
+    while renderer.samples_done() < spp {
+        renderer.advance(spp - renderer.samples_done()).unwrap();
+    }
+    Outcome {
+        accumulation: renderer.accumulation().unwrap(),
+        rays: renderer.rays_traced().unwrap(),
+        dropped: renderer.samples_dropped().unwrap(),
+    }
+}
+
+/// Renders `scene` with both kernels and asserts the outcomes are the same.
+fn assert_same(label: &str, scene: &Scene, spp: u32, rows: u32, samples: u32) {
+    let mega = render(scene, Kernel::Megakernel, spp, rows, samples);
+    let wave = render(scene, Kernel::Wavefront, spp, rows, samples);
+    assert!(mega.rays > 0, "{label}: no rays traced");
+    assert_eq!(mega.rays, wave.rays, "{label}: rays traced");
+    assert_eq!(mega.dropped, wave.dropped, "{label}: samples dropped");
+    assert_eq!(
+        mega.accumulation.cursor, wave.accumulation.cursor,
+        "{label}: samples held"
+    );
+    let differ = mega
+        .accumulation
+        .sums
+        .iter()
+        .zip(&wave.accumulation.sums)
+        .filter(|(a, b)| a != b)
+        .count();
+    assert_eq!(differ, 0, "{label}: {differ} pixels' sums differ");
+    assert!(
+        mega.accumulation.aovs == wave.accumulation.aovs,
+        "{label}: auxiliary images differ"
+    );
+}
+
+#[test]
+fn wavefront_matches_the_megakernel_bit_for_bit() {
+    // The default scene (a texture, glass, metal; odd size) with auxiliary images, in bands
+    // of 5 rows, then in batches of 3 samples over the whole image.
+    let mut default =
+        pathlight_scene::load_scene_file(&repo().join("scenes/default.toml")).unwrap();
+    default.camera.width = 37;
+    default.camera.height = 23;
+    default.settings.aovs = true;
+    assert_same("default scene, bands", &default, 2, 5, 1);
+    assert_same("default scene, batches", &default, 6, 23, 3);
+    // Instances; glTF's metal-rough layers; an environment map and the sun; many lights.
+    for name in [
+        "instances.toml",
+        "layers.toml",
+        "refs/env-sun.toml",
+        "refs/lights.toml",
+    ] {
+        assert_same(name, &scene(name, 24, 2, 7), 2, 24, 2);
+    }
+    // Camera rays only; long paths (64 segments, no roulette) in glass.
+    let mut direct = scene("refs/cornell-materials.toml", 20, 2, 3);
+    direct.settings.max_depth = 1;
+    assert_same("max_depth 1", &direct, 2, 20, 2);
+    assert_same(
+        "glass furnace, 64 segments",
+        &scene("refs/furnace-glass.toml", 16, 2, 5),
+        2,
+        16,
+        2,
+    );
+}
+
+#[test]
+fn wavefront_counts_the_samples_it_drops() {
+    let mut s = scene("refs/cornell-diffuse.toml", 16, 2, 1);
+    for m in &mut s.materials {
+        if m.emission.max_element() > 0.0 {
+            m.emission.x = f32::NAN;
+        }
+    }
+    let wave = render(&s, Kernel::Wavefront, 2, 16, 2);
+    assert!(wave.dropped > 10, "{} of 512 samples counted", wave.dropped);
+    assert_same("NaN emission", &s, 2, 16, 2);
+}
