@@ -14,7 +14,7 @@
 
 #import integrator
 
-// Fields of a path's state, each an array of `capacity` vec4s in `paths`.
+// Fields of a path's state, each an array of `CAPACITY` vec4s in `paths`.
 // Ray origin; the density of the BSDF sample that produced the ray.
 const F_ORIGIN: u32 = 0u;
 // Ray direction; the product of the refractions' eta.
@@ -55,7 +55,7 @@ const COUNT_SAMPLE: u32 = 6u;
 const QUEUE_SHADOW: u32 = 2u;
 
 @group(2) @binding(0) var<storage, read_write> paths: array<vec4f>;
-// Four queues of `capacity` path slots each: extension 0 and 1, shadow 0 and 1.
+// Four queues of `CAPACITY` path slots each: extension 0 and 1, shadow 0 and 1.
 @group(2) @binding(1) var<storage, read_write> queues: array<u32>;
 @group(2) @binding(2) var<storage, read_write> queue_counts: array<atomic<u32>, 8>;
 // The same buffer read with plain loads: a kernel reads only words that no invocation of its
@@ -63,9 +63,34 @@ const QUEUE_SHADOW: u32 = 2u;
 // without an atomic each or a barrier to share one.
 @group(2) @binding(3) var<storage, read_write> queue_lengths: array<u32, 8>;
 
-// Appends `slot` to queue `q`.
+// The next segment's dispatches, as `dispatch_workgroups_indirect` reads them: the trace
+// kernel's workgroups (x, 1, 1), then the shading's. Each counts one workgroup more than its
+// queues need, so no dispatch is empty (its first invocation resets the other buffer), and
+// counts a queue's workgroups on its own, so the trace kernel's may be one more again.
+// Two buffers alternate by segment: one is read as a dispatch while the kernels fill the other.
+@group(3) @binding(0) var<storage, read_write> next_dispatch: array<atomic<u32>, 8>;
+
+// Appends `slot` to queue `q`, counting the workgroups of 64 invocations its entries take.
 fn enqueue(q: u32, slot: u32) {
-    queues[q * capacity() + atomicAdd(&queue_counts[q], 1u)] = slot;
+    let i = atomicAdd(&queue_counts[q], 1u);
+    queues[q * CAPACITY + i] = slot;
+    if i % 64u == 0u {
+        atomicAdd(&next_dispatch[0], 1u);
+        if q < QUEUE_SHADOW {
+            atomicAdd(&next_dispatch[3], 1u);
+        }
+    }
+}
+
+// Sets `next_dispatch` to `trace` and `shade` workgroups.
+fn set_next_dispatch(trace: u32, shade: u32) {
+    atomicStore(&next_dispatch[0], trace);
+    atomicStore(&next_dispatch[3], shade);
+    for (var k = 1u; k < 6u; k++) {
+        if k != 3u {
+            atomicStore(&next_dispatch[k], 1u);
+        }
+    }
 }
 
 // Adds `n` rays to the 64-bit ray count of `counters`.
@@ -76,13 +101,12 @@ fn count_rays(n: u32) {
     }
 }
 
-// Path slots: one per pixel of the image (a band uses the first of them).
-fn capacity() -> u32 {
-    return params.width * params.height;
-}
+// Path slots: the most paths of a wave (a band of rows, or the part of one the host cuts so
+// that the state fits a binding and the dispatches their limit). The host sets it.
+override CAPACITY: u32 = 1048576u;
 
 fn field(f: u32, slot: u32) -> u32 {
-    return f * capacity() + slot;
+    return f * CAPACITY + slot;
 }
 
 // The pixel of slot `slot` of the band.
@@ -113,6 +137,8 @@ fn wf_start(@builtin(global_invocation_id) gid: vec3u) {
         atomicStore(&queue_counts[COUNT_SHADOW], 0u);
         atomicStore(&queue_counts[COUNT_SHADOW + 1u], 0u);
         atomicStore(&queue_counts[SEGMENT_TRACE], 0u);
+        let groups = 1u + (params.width * (params.row_end - params.row_offset) + 63u) / 64u;
+        set_next_dispatch(groups, groups);
     }
     let sample_index = params.sample_offset + queue_lengths[COUNT_SAMPLE];
     var sampler = sampler_init(params.sampler, y * params.width + x, sample_index, params.seed);
@@ -136,14 +162,15 @@ fn wf_start(@builtin(global_invocation_id) gid: vec3u) {
 // The shadow rays the last segment's shading queued (their light samples' radiance where
 // nothing blocks them), then the nearest hits of the extension rays it queued.
 @compute @workgroup_size(64)
-fn wf_trace(@builtin(global_invocation_id) gid: vec3u, @builtin(num_workgroups) groups: vec3u) {
+fn wf_trace(@builtin(global_invocation_id) gid: vec3u) {
     let segment = queue_lengths[SEGMENT_TRACE];
     let into = segment & 1u;
     let n_shadow = queue_lengths[QUEUE_SHADOW + 1u - into];
     let n = n_shadow + queue_lengths[into];
-    let i = gid.x + gid.y * groups.x * 64u;
+    let i = gid.x;
     if i == 0u {
-        // The queues this segment's shading fills; nothing reads them now.
+        // The queues and dispatches this segment's shading fills; nothing reads them now.
+        set_next_dispatch(1u, 1u);
         atomicStore(&queue_counts[1u - into], 0u);
         atomicStore(&queue_counts[QUEUE_SHADOW + into], 0u);
         atomicStore(&queue_counts[SEGMENT_SHADE], segment);
@@ -151,9 +178,9 @@ fn wf_trace(@builtin(global_invocation_id) gid: vec3u, @builtin(num_workgroups) 
     }
     if i < n {
         if i < n_shadow {
-            trace_shadow(queues[(QUEUE_SHADOW + 1u - into) * capacity() + i]);
+            trace_shadow(queues[(QUEUE_SHADOW + 1u - into) * CAPACITY + i]);
         } else {
-            trace_extension(queues[into * capacity() + i - n_shadow]);
+            trace_extension(queues[into * CAPACITY + i - n_shadow]);
         }
     }
 }
@@ -179,16 +206,16 @@ fn trace_extension(slot: u32) {
 
 // Shades every queued path at its hit.
 @compute @workgroup_size(64)
-fn wf_shade(@builtin(global_invocation_id) gid: vec3u, @builtin(num_workgroups) groups: vec3u) {
+fn wf_shade(@builtin(global_invocation_id) gid: vec3u) {
     let segment = queue_lengths[SEGMENT_SHADE];
     let into = segment & 1u;
     let n = queue_lengths[into];
-    let i = gid.x + gid.y * groups.x * 64u;
+    let i = gid.x;
     if i == 0u {
         atomicStore(&queue_counts[SEGMENT_TRACE], segment + 1u);
     }
     if i < n {
-        shade_path(queues[into * capacity() + i], into);
+        shade_path(queues[into * CAPACITY + i], into);
     }
 }
 

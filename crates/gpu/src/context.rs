@@ -91,10 +91,16 @@ pub fn available_adapters() -> Vec<Adapter> {
     adapters_on(wgpu::Backends::GL)
 }
 
+/// wgpu's check of indirect dispatches' arguments, left out: it adds a dispatch and barriers
+/// before each indirect one, and the only indirect dispatches, the wavefront's
+/// (`wavefront.rs`), bound their arguments themselves.
+const UNCHECKED_INDIRECT: wgpu::InstanceFlags = wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL;
+
 /// Adapters on `backends`, from an instance that initialises only those backends.
 fn adapters_on(backends: wgpu::Backends) -> Vec<Adapter> {
     let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
     descriptor.backends = backends;
+    descriptor.flags.remove(UNCHECKED_INDIRECT);
     let instance = wgpu::Instance::new(descriptor);
     pollster::block_on(instance.enumerate_adapters(backends))
 }
@@ -158,6 +164,7 @@ impl GpuContext {
                 Box::new(window.clone()),
             );
             descriptor.backends = backends;
+            descriptor.flags.remove(UNCHECKED_INDIRECT);
             let instance = wgpu::Instance::new(descriptor);
             let surface = match instance.create_surface(window.clone()) {
                 Ok(surface) => surface,

@@ -288,13 +288,12 @@ impl GpuRenderer {
             self.stack_size,
             self.features,
         )?;
-        let pixels = u64::from(self.params.width) * u64::from(self.params.height);
         Wavefront::new(
             &self.ctx.device,
             &kernel,
             &self.scene.layout,
             &self.frame_layout,
-            pixels,
+            (self.params.width, self.params.height),
             self.features.aovs,
         )
     }
@@ -325,6 +324,15 @@ impl GpuRenderer {
 
     /// Queues `samples` samples per pixel for rows `row .. row + rows`.
     fn submit(&self, row: u32, rows: u32, samples: u32) {
+        // The wavefront takes the band in waves of paths its dispatches can hold.
+        let wave = self.wavefront.as_ref().map_or(rows, Wavefront::rows);
+        for start in (row..row + rows).step_by(wave as usize) {
+            self.submit_wave(start, wave.min(row + rows - start), samples);
+        }
+    }
+
+    /// Queues `samples` samples per pixel for rows `row .. row + rows` as one submission.
+    fn submit_wave(&self, row: u32, rows: u32, samples: u32) {
         let params = GpuRenderParams {
             sample_offset: self.cursor.next_sample(),
             batch_samples: samples,

@@ -12,8 +12,6 @@ pub const WAVEFRONT_ENTRY_POINTS: [&str; 4] = ["wf_start", "wf_trace", "wf_shade
 const WORKGROUP: u32 = 8;
 /// Lanes of the queue kernels' workgroups (`@workgroup_size(64)`).
 const QUEUE_WORKGROUP: u32 = 64;
-/// Workgroups in a row of a queue kernel's grid (at most 65,535 in a dimension).
-const MAX_QUEUE_ROW: u32 = 32768;
 /// Word of `queue_counts` holding the sample of the batch.
 const COUNT_SAMPLE: u64 = 6;
 /// vec4s of a path's state, without and with auxiliary images (`F_*` in the shader).
@@ -30,19 +28,50 @@ pub struct Wavefront {
     bind_group: wgpu::BindGroup,
     /// The queue counters (`queue_counts`).
     counts: wgpu::Buffer,
+    /// The two buffers of dispatch arguments (`next_dispatch`) and a bind group of each.
+    dispatches: [wgpu::Buffer; 2],
+    dispatch_groups: [wgpu::BindGroup; 2],
+    /// Rows one wave holds: the path state has room for that many rows' paths.
+    rows: u32,
 }
 
 impl Wavefront {
-    /// The kernels of `kernel` (the assembled `wavefront` module), and path state for
-    /// `pixels` paths (with auxiliary images or not), or why the device cannot hold it.
+    /// The kernels of `kernel` (the assembled `wavefront` module), and path state for waves
+    /// of whole rows of a `width` x `height` image (with auxiliary images or not), as many
+    /// rows as the device's limits allow, or why it cannot hold one row.
     pub fn new(
         device: &wgpu::Device,
         kernel: &IntegratorKernel,
         scene_layout: &wgpu::BindGroupLayout,
         frame_layout: &wgpu::BindGroupLayout,
-        pixels: u64,
+        (width, height): (u32, u32),
         aovs: bool,
     ) -> Result<Self, RenderError> {
+        let fields = if aovs { FIELDS_WITH_AOVS } else { FIELDS };
+        let limits = device.limits();
+        // The trace kernel's workgroups: at most 1 + ceil(shadows / 64) + ceil(extensions / 64)
+        // <= 3 + paths / 32, under the limit of a dispatch; the state under a binding's.
+        let by_dispatch = u64::from(
+            limits
+                .max_compute_workgroups_per_dimension
+                .saturating_sub(3)
+                / 2,
+        ) * u64::from(QUEUE_WORKGROUP);
+        let by_binding = limits.max_storage_buffer_binding_size / (fields * 16);
+        let pixels = u64::from(width) * u64::from(height);
+        // Whole rows.
+        let rows =
+            (pixels.min(by_dispatch).min(by_binding) / u64::from(width)).min(u64::from(height));
+        if rows == 0 {
+            return Err(RenderError::Limits(format!(
+                "a row of {width} pixels does not fit the wavefront's path state on this device \
+                 (at most {} paths); use the megakernel",
+                by_dispatch.min(by_binding)
+            )));
+        }
+        let capacity = rows as u32 * width;
+        let mut constants = kernel.constants.clone();
+        constants.push(("CAPACITY", f64::from(capacity)));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("wavefront layout"),
             entries: &[
@@ -52,28 +81,15 @@ impl Wavefront {
                 storage_entry(3, false),
             ],
         });
-        let layouts = [scene_layout, frame_layout, &layout];
+        let dispatch_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("wavefront dispatch layout"),
+            entries: &[storage_entry(0, false)],
+        });
+        let layouts = [scene_layout, frame_layout, &layout, &dispatch_layout];
         let pipeline = |entry: &str| {
-            create_compute_pipeline(
-                device,
-                entry,
-                &kernel.source,
-                entry,
-                &layouts,
-                &kernel.constants,
-            )
+            create_compute_pipeline(device, entry, &kernel.source, entry, &layouts, &constants)
         };
-        let fields = if aovs { FIELDS_WITH_AOVS } else { FIELDS };
-        let state_size = fields * pixels * 16;
-        let limit = device.limits().max_storage_buffer_binding_size;
-        if state_size > limit {
-            return Err(RenderError::Limits(format!(
-                "the wavefront's path state for {pixels} pixels takes {} MiB; this device binds \
-                 at most {} MiB (use the megakernel, or a smaller image)",
-                state_size >> 20,
-                limit >> 20
-            )));
-        }
+        let state_size = fields * u64::from(capacity) * 16;
         let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -84,7 +100,7 @@ impl Wavefront {
         };
         use wgpu::BufferUsages as Usage;
         let paths = buffer("path state", state_size, Usage::STORAGE);
-        let queues = buffer("path queues", 4 * pixels * 4, Usage::STORAGE);
+        let queues = buffer("path queues", 4 * u64::from(capacity) * 4, Usage::STORAGE);
         let counts = buffer("queue counts", 8 * 4, Usage::STORAGE | Usage::COPY_DST);
         let bind_group = bind_buffers(
             device,
@@ -92,6 +108,22 @@ impl Wavefront {
             &layout,
             &[&paths, &queues, &counts, &counts],
         );
+        let dispatches = [0, 1].map(|_| {
+            buffer(
+                "wavefront dispatches",
+                8 * 4,
+                Usage::STORAGE | Usage::INDIRECT,
+            )
+        });
+        let dispatch_groups = [0, 1].map(|k| {
+            bind_buffers(
+                device,
+                "wavefront dispatches",
+                &dispatch_layout,
+                &[&dispatches[k]],
+            )
+        });
+
         Ok(Self {
             start: pipeline("wf_start")?,
             trace: pipeline("wf_trace")?,
@@ -99,11 +131,19 @@ impl Wavefront {
             finish: pipeline("wf_finish")?,
             bind_group,
             counts,
+            dispatches,
+            dispatch_groups,
+            rows: rows as u32,
         })
     }
 
-    /// Records `samples` samples of `rows` rows `width` wide, `max_depth` segments each,
-    /// into `encoder`, with bind groups `scene` (0) and `frame` (1).
+    /// Rows of the image one wave holds.
+    pub fn rows(&self) -> u32 {
+        self.rows
+    }
+
+    /// Records `samples` samples of `rows` rows (at most [`Self::rows`]) `width` wide,
+    /// `max_depth` segments each, into `encoder`, with bind groups `scene` (0) and `frame` (1).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -125,27 +165,24 @@ impl Wavefront {
         pass.set_bind_group(1, frame, &[]);
         pass.set_bind_group(2, &self.bind_group, &[]);
         let grid = (width.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP));
-        // One invocation per entry a queue can hold (the trace kernel's: a shadow and an
-        // extension ray per path), on a 2D grid past the 65,535 workgroups of a dimension.
-        let queue_groups = |lanes: u32| {
-            let groups = lanes.div_ceil(QUEUE_WORKGROUP);
-            let x = groups.min(MAX_QUEUE_ROW);
-            (x, groups.div_ceil(x))
+        // Segment s reads its dispatches from buffer s % 2 while its kernels fill the other.
+        let segment = |pass: &mut wgpu::ComputePass, s: u32, kernels: &[&wgpu::ComputePipeline]| {
+            let k = (s % 2) as usize;
+            pass.set_bind_group(3, &self.dispatch_groups[1 - k], &[]);
+            for (kernel, offset) in kernels.iter().zip([0, 12]) {
+                pass.set_pipeline(kernel);
+                pass.dispatch_workgroups_indirect(&self.dispatches[k], offset);
+            }
         };
-        let trace_groups = queue_groups(2 * width * rows);
-        let shade_groups = queue_groups(width * rows);
         for _ in 0..samples {
+            pass.set_bind_group(3, &self.dispatch_groups[0], &[]);
             pass.set_pipeline(&self.start);
             pass.dispatch_workgroups(grid.0, grid.1, 1);
-            for _ in 0..max_depth {
-                pass.set_pipeline(&self.trace);
-                pass.dispatch_workgroups(trace_groups.0, trace_groups.1, 1);
-                pass.set_pipeline(&self.shade);
-                pass.dispatch_workgroups(shade_groups.0, shade_groups.1, 1);
+            for s in 0..max_depth {
+                segment(&mut pass, s, &[&self.trace, &self.shade]);
             }
             // The last segment's shadow rays.
-            pass.set_pipeline(&self.trace);
-            pass.dispatch_workgroups(trace_groups.0, trace_groups.1, 1);
+            segment(&mut pass, max_depth, &[&self.trace]);
             pass.set_pipeline(&self.finish);
             pass.dispatch_workgroups(grid.0, grid.1, 1);
         }

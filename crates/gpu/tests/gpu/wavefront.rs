@@ -97,6 +97,15 @@ fn wavefront_matches_the_megakernel_bit_for_bit() {
 }
 
 #[test]
+fn wavefront_cuts_a_large_image_into_waves() {
+    // 1,000,000 paths: more than lavapipe's 128 MiB bindings hold of path state (838,860
+    // paths), so the image is rendered in two waves of rows.
+    let mut large = scene("refs/cornell-diffuse.toml", 1000, 1, 9);
+    large.settings.max_depth = 2;
+    assert_same("1000x1000 in waves", &large, 1, 1000, 1);
+}
+
+#[test]
 fn wavefront_counts_the_samples_it_drops() {
     let mut s = scene("refs/cornell-diffuse.toml", 16, 2, 1);
     for m in &mut s.materials {
