@@ -3,8 +3,8 @@
 // kernels of their own, without the shading's live state beside them, and each kernel's
 // lanes take the paths still alive from a queue, so a warp's lanes stay busy.
 //
-// One sample per pixel of a band: `wf_start` makes every path's camera ray; then, per
-// segment, `wf_trace` traces the shadow rays the last shading queued and the extension rays
+// A wave of paths (one or more samples of every pixel of a band of rows): `wf_start` makes
+// every path's camera ray; then, per segment, `wf_trace` traces the shadow rays the last shading queued and the extension rays
 // it queued (one kernel, so a segment is two dispatches), and `wf_shade` shades the hits
 // (emission, the light sample as a shadow ray, the BSDF sample as the next extension ray);
 // a last `wf_trace` traces the last shadow rays and `wf_finish` adds the samples to the film.
@@ -52,6 +52,7 @@ const COUNT_SHADOW: u32 = 2u;
 const SEGMENT_TRACE: u32 = 4u;
 const SEGMENT_SHADE: u32 = 5u;
 const COUNT_SAMPLE: u32 = 6u;
+const COUNT_WAVE_SAMPLES: u32 = 7u;
 const QUEUE_SHADOW: u32 = 2u;
 
 @group(2) @binding(0) var<storage, read_write> paths: array<vec4f>;
@@ -109,9 +110,14 @@ fn field(f: u32, slot: u32) -> u32 {
     return f * CAPACITY + slot;
 }
 
-// The pixel of slot `slot` of the band.
+// Pixels of the band; a wave holds one or more samples of each (slot: sample * band + pixel).
+fn band_pixels() -> u32 {
+    return params.width * (params.row_end - params.row_offset);
+}
+
+// The pixel of slot `slot` of the wave.
 fn slot_pixel(slot: u32) -> u32 {
-    return params.row_offset * params.width + slot;
+    return params.row_offset * params.width + slot % band_pixels();
 }
 
 // The sampler of a path at its dimension and PCG state.
@@ -122,25 +128,27 @@ fn path_sampler(slot: u32, dimension: u32, rng_state: u32, sample_index: u32) ->
     return s;
 }
 
-// Every path of the band: its camera ray, queued for extension.
+// Every path of the wave (one path per pixel of the band for each of `num_workgroups.z`
+// samples): its camera ray, queued for extension.
 @compute @workgroup_size(8, 8)
-fn wf_start(@builtin(global_invocation_id) gid: vec3u) {
+fn wf_start(@builtin(global_invocation_id) gid: vec3u, @builtin(num_workgroups) groups: vec3u) {
     let x = gid.x;
     let y = gid.y + params.row_offset;
     if x >= params.width || y >= params.row_end {
         return;
     }
-    let slot = (y - params.row_offset) * params.width + x;
+    let slot = gid.z * band_pixels() + (y - params.row_offset) * params.width + x;
     if slot == 0u {
-        atomicStore(&queue_counts[0], params.width * (params.row_end - params.row_offset));
+        let n = band_pixels() * groups.z;
+        atomicStore(&queue_counts[0], n);
         atomicStore(&queue_counts[1], 0u);
         atomicStore(&queue_counts[COUNT_SHADOW], 0u);
         atomicStore(&queue_counts[COUNT_SHADOW + 1u], 0u);
         atomicStore(&queue_counts[SEGMENT_TRACE], 0u);
-        let groups = 1u + (params.width * (params.row_end - params.row_offset) + 63u) / 64u;
-        set_next_dispatch(groups, groups);
+        atomicStore(&queue_counts[COUNT_WAVE_SAMPLES], groups.z);
+        set_next_dispatch(1u + (n + 63u) / 64u, 1u + (n + 63u) / 64u);
     }
-    let sample_index = params.sample_offset + queue_lengths[COUNT_SAMPLE];
+    let sample_index = params.sample_offset + queue_lengths[COUNT_SAMPLE] + gid.z;
     var sampler = sampler_init(params.sampler, y * params.width + x, sample_index, params.seed);
     let ray = camera_ray(x, y, &sampler);
     var flags = 1u | PATH_PREV_DELTA;
@@ -356,34 +364,46 @@ fn shade_path(slot: u32, into: u32) {
     }
 }
 
-// Adds every path of the band to the film (and its auxiliary images).
+// Adds every path of the wave to the film (and its auxiliary images), a pixel's samples in
+// one invocation.
 @compute @workgroup_size(8, 8)
 fn wf_finish(@builtin(global_invocation_id) gid: vec3u) {
     let x = gid.x;
     let y = gid.y + params.row_offset;
     if x < params.width && y < params.row_end {
-        let slot = (y - params.row_offset) * params.width + x;
-        if slot == 0u {
-            // The next `wf_start` takes the batch's next sample.
-            atomicAdd(&queue_counts[COUNT_SAMPLE], 1u);
+        let samples = queue_lengths[COUNT_WAVE_SAMPLES];
+        let first = (y - params.row_offset) * params.width + x;
+        if first == 0u {
+            // The next `wf_start` takes the batch's next samples.
+            atomicAdd(&queue_counts[COUNT_SAMPLE], samples);
         }
         let pixel = y * params.width + x;
-        let radiance = paths[field(F_RADIANCE, slot)].xyz;
         var total = accum[pixel];
-        if is_finite3(radiance) {
-            add_sample(&total, radiance);
-        } else {
-            atomicAdd(&counters[2], 1u);
+        var zero = AccumPixel(vec4u(0u), vec4u(0u));
+        var aovs = AovPixel(zero, zero);
+        for (var s = 0u; s < samples; s++) {
+            let slot = s * band_pixels() + first;
+            let radiance = paths[field(F_RADIANCE, slot)].xyz;
+            if is_finite3(radiance) {
+                add_sample(&total, radiance);
+            } else {
+                atomicAdd(&counters[2], 1u);
+            }
+            if AOVS && params.aovs != 0u {
+                var albedo = paths[field(F_ALBEDO, slot)].xyz;
+                if (bitcast<u32>(paths[field(F_THROUGHPUT, slot)].w) & PATH_AOV_PENDING) != 0u {
+                    albedo = paths[field(F_AOV_WEIGHT, slot)].xyz;
+                }
+                add_aov_sample(&aovs, PathResult(radiance, albedo, paths[field(F_NORMAL, slot)].xyz));
+            }
         }
         accum[pixel] = total;
         if AOVS && params.aovs != 0u {
-            var albedo = paths[field(F_ALBEDO, slot)].xyz;
-            if (bitcast<u32>(paths[field(F_THROUGHPUT, slot)].w) & PATH_AOV_PENDING) != 0u {
-                albedo = paths[field(F_AOV_WEIGHT, slot)].xyz;
-            }
-            var acc = aov[pixel];
-            add_aov_sample(&acc, PathResult(radiance, albedo, paths[field(F_NORMAL, slot)].xyz));
-            aov[pixel] = acc;
+            var albedo = aov[pixel].albedo;
+            add_fixed(&albedo, aovs.albedo);
+            var normal = aov[pixel].normal;
+            add_fixed(&normal, aovs.normal);
+            aov[pixel] = AovPixel(albedo, normal);
         }
     }
 }
