@@ -469,6 +469,18 @@ fn bench_and_view_refuse_bad_options() {
         ],
         &["brute-force", "GPU backend"],
     );
+    fails_with(
+        &[
+            "bench",
+            "--backend",
+            "cpu",
+            "--gpu-kernel",
+            "wavefront",
+            "--frames",
+            "1",
+        ],
+        &["--gpu-kernel wavefront", "GPU backend"],
+    );
     for strength in ["-1", "0", "nan"] {
         let output = pathlight(&["view", "--light-strength", strength]);
         let err = stderr(&output);
