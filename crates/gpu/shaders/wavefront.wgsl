@@ -4,13 +4,16 @@
 // lanes take the paths still alive from a queue, so a warp's lanes stay busy.
 //
 // A wave of paths (one or more samples of every pixel of a band of rows): `wf_start` makes
-// every path's camera ray; then, per segment, `wf_trace` traces the shadow rays the last shading queued and the extension rays
-// it queued (one kernel, so a segment is two dispatches), and `wf_shade` shades the hits
-// (emission, the light sample as a shadow ray, the BSDF sample as the next extension ray);
-// a last `wf_trace` traces the last shadow rays and `wf_finish` adds the samples to the film.
-// A shadow ray is traced before the path's next extension ray is shaded, so the estimator and
-// the order of every sum are `trace_path`'s and the images are the same bit for bit (a test
-// holds them together). CPU twin: `crates/cpu/src/integrator.rs` (through `trace_path`).
+// every path's camera ray; then, per segment, `wf_trace` traces the shadow rays the last
+// shading queued and the extension rays it queued (one kernel, so a segment is two
+// dispatches), and `wf_shade` shades the hits (emission, the light sample as a shadow ray,
+// the BSDF sample as the next extension ray); a last `wf_trace` traces the last shadow rays
+// and `wf_finish` adds the samples to the film. A shadow ray is traced before the path's next
+// extension ray is shaded, so the estimator and the order of every sum are `trace_path`'s and
+// the images are the same bit for bit (`crates/gpu/tests/gpu/wavefront.rs` holds them
+// together).
+// No CPU twin: the same pass as `integrator.wgsl`, cut into kernels; the CPU backend's twin of
+// that pass is `crates/cpu/src/integrator.rs`.
 
 #import integrator
 
