@@ -427,6 +427,15 @@ impl GpuAccumPixel {
         }
     }
 
+    /// `channel c += x`, `x` a 64-bit fixed-point number (whole part in the high word),
+    /// saturating as [`Self::accumulate`] does.
+    #[inline(always)]
+    pub fn add_to_channel(&mut self, c: usize, x: u64) {
+        let sum = (u64::from(self.hi[c]) << 32 | u64::from(self.lo[c])).saturating_add(x);
+        self.hi[c] = (sum >> 32) as u32;
+        self.lo[c] = sum as u32;
+    }
+
     /// The sum of channel `c` as a float.
     pub fn channel_sum(&self, c: usize) -> f64 {
         f64::from(self.hi[c]) + f64::from(self.lo[c]) / 4_294_967_296.0

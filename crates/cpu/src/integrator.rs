@@ -330,15 +330,13 @@ pub fn accumulated_value(radiance: Vec3A) -> Vec3A {
 /// Twin of WGSL `add_sample`.
 #[inline(always)]
 pub fn add_sample(acc: &mut GpuAccumPixel, value: Vec3A) {
-    let v = value.clamp(Vec3A::ZERO, Vec3A::splat(SAMPLE_MAX));
-    let whole = v.floor();
-    // frac * 2^32 is exact: frac has 24 significant bits and the scale is a power of two.
-    let frac = (v - whole) * 4_294_967_296.0;
-    let sample = GpuAccumPixel {
-        hi: [whole.x as u32, whole.y as u32, whole.z as u32, 0],
-        lo: [frac.x as u32, frac.y as u32, frac.z as u32, 0],
-    };
-    add_fixed(acc, &sample);
+    // v * 2^32 is exact (a float below 2^24 scaled by a power of two), and its integer part is
+    // WGSL's floor(v) * 2^32 + trunc(fract(v) * 2^32): the same fixed-point number, converted
+    // once instead of in two halves.
+    let scaled = value.clamp(Vec3A::ZERO, Vec3A::splat(SAMPLE_MAX)) * 4_294_967_296.0;
+    for (c, x) in scaled.to_array().into_iter().enumerate() {
+        acc.add_to_channel(c, x as u64);
+    }
 }
 
 /// `acc +=` the auxiliary images of `sample`: the albedo, and the normal as `(n + 1) / 2`
@@ -360,9 +358,54 @@ pub fn add_aov_sample(acc: &mut GpuAovPixel, sample: &PathSample) {
     add_sample(&mut acc.normal, normal);
 }
 
-/// `acc += x` on 64-bit fixed point, saturating instead of wrapping. Twin of WGSL
-/// `add_fixed`.
-#[inline(always)]
-pub fn add_fixed(acc: &mut GpuAccumPixel, x: &GpuAccumPixel) {
-    acc.accumulate(x);
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// WGSL `add_sample`'s arithmetic: the whole and the fractional part converted apart,
+    /// added with a carry, saturating to all ones.
+    fn add_sample_in_halves(acc: &mut GpuAccumPixel, value: Vec3A) {
+        let v = value.clamp(Vec3A::ZERO, Vec3A::splat(SAMPLE_MAX));
+        let whole = v.floor();
+        let frac = (v - whole) * 4_294_967_296.0;
+        acc.accumulate(&GpuAccumPixel {
+            hi: [whole.x as u32, whole.y as u32, whole.z as u32, 0],
+            lo: [frac.x as u32, frac.y as u32, frac.z as u32, 0],
+        });
+    }
+
+    /// The one conversion gives WGSL's sums bit for bit: every float exponent from 2^-149 to
+    /// past the clamp, values next to whole numbers, negatives, NaN and infinities, and sums
+    /// that saturate.
+    #[test]
+    fn add_sample_is_the_wgsl_sum_bit_for_bit() {
+        let mut values = vec![0.0, -0.0, -1.0, f32::NAN, f32::INFINITY, -f32::INFINITY];
+        let mut state = 0x2545_f491_u32;
+        for exponent in -149..30 {
+            let base = 2f32.powi(exponent);
+            for _ in 0..64 {
+                state ^= state << 13;
+                state ^= state >> 17;
+                state ^= state << 5;
+                let v = base * (1.0 + state as f32 / 4_294_967_296.0);
+                values.extend([v, v.floor(), v.next_down(), v.ceil().next_down()]);
+            }
+        }
+        values.extend([SAMPLE_MAX, SAMPLE_MAX.next_down(), SAMPLE_MAX * 2.0]);
+        let mut ours = GpuAccumPixel::default();
+        let mut theirs = GpuAccumPixel::default();
+        for (i, v) in values.iter().enumerate() {
+            let sample = Vec3A::new(*v, values[(i * 7) % values.len()], 0.5);
+            add_sample(&mut ours, sample);
+            add_sample_in_halves(&mut theirs, sample);
+            assert_eq!(ours, theirs, "after {sample}");
+        }
+        // Sums past 2^32 per channel saturate the same way.
+        for _ in 0..300 {
+            add_sample(&mut ours, Vec3A::splat(SAMPLE_MAX));
+            add_sample_in_halves(&mut theirs, Vec3A::splat(SAMPLE_MAX));
+        }
+        assert_eq!(ours.hi[0], u32::MAX);
+        assert_eq!(ours, theirs);
+    }
 }

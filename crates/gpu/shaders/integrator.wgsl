@@ -40,8 +40,8 @@ fn add_sample(acc: ptr<function, AccumPixel>, value: vec3f) {
     add_fixed(acc, AccumPixel(vec4u(hi, 0u), vec4u(lo, 0u)));
 }
 
-// `acc += x` on 64-bit fixed point, saturating instead of wrapping.
-// CPU twin: `add_fixed`
+// `acc += x` on 64-bit fixed point, saturating instead of wrapping (on the host:
+// `GpuAccumPixel::accumulate`, and per channel `GpuAccumPixel::add_to_channel`).
 fn add_fixed(acc: ptr<function, AccumPixel>, x: AccumPixel) {
     let lo = (*acc).lo + x.lo;
     let carry = select(vec4u(0u), vec4u(1u), lo < x.lo);
