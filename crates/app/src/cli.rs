@@ -277,9 +277,10 @@ impl From<AccelArg> for pathlight_gpu::Accel {
 pub enum GpuKernelArg {
     /// One kernel follows each path from the camera to its end.
     Megakernel,
-    /// Kernels over queues of paths, one segment of every path at a time: faster on large
-    /// images (1920x1080 and up) on a discrete GPU and on lavapipe, slower on small images
-    /// of deep paths (BENCHMARKS.md, "The wavefront split").
+    /// Kernels over queues of paths, one segment of every path at a time: faster on lavapipe
+    /// except for deep paths in small images; not yet measured on a GPU in this form (an
+    /// earlier one was faster at 1920x1080, slower at 500x500; BENCHMARKS.md, "The wavefront
+    /// split").
     Wavefront,
 }
 
