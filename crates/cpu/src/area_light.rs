@@ -212,5 +212,6 @@ pub fn sample_area_light(
         pdf,
         valid: pdf > 0.0 && pdf.is_finite(),
         mis: true,
+        map_cell: None,
     }
 }

@@ -44,8 +44,11 @@ fn map_uv(d: Vec3A) -> Vec2 {
     Vec2::new(u - u.floor(), acos(d.y.clamp(-1.0, 1.0)) * FRAC_1_PI)
 }
 
-/// The cell holding `uv` and the position in it. Twin of WGSL `MapCell`.
-struct MapCell {
+/// A cell of the map (between texel columns `column` and `column + 1`, wrapping, and rows
+/// `row` and `row + 1`) and a position in it, `f` in [0, 1]^2 from texel (`column`, `row`).
+/// Twin of WGSL `MapCell`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapCell {
     column: u32,
     row: u32,
     f: Vec2,
@@ -65,19 +68,6 @@ fn map_cell(params: &GpuRenderParams, uv: Vec2) -> MapCell {
         row,
         f: Vec2::new(x - column as f32, y - row as f32),
     }
-}
-
-/// Radiance seen looking along world direction `dir`. Twin of WGSL `env_radiance`.
-#[inline(always)]
-pub fn env_radiance(scene: &CpuScene, params: &GpuRenderParams, dir: Vec3A) -> Vec3A {
-    if !has_env_map(params) {
-        return Vec3A::from(params.environment);
-    }
-    cell_radiance(
-        scene,
-        params,
-        &map_cell(params, map_uv(to_map(params, dir))),
-    )
 }
 
 /// What a path escaping along world direction `dir` from a point of normal `n` sees: the
@@ -111,7 +101,7 @@ pub fn env_escape(
 
 /// The map's bilinear radiance at `c`. Twin of WGSL `cell_radiance`.
 #[inline(always)]
-fn cell_radiance(scene: &CpuScene, params: &GpuRenderParams, c: &MapCell) -> Vec3A {
+pub fn cell_radiance(scene: &CpuScene, params: &GpuRenderParams, c: &MapCell) -> Vec3A {
     let w = params.env_width;
     let right = if c.column + 1 == w { 0 } else { c.column + 1 };
     let top = c.row * w;
@@ -180,10 +170,16 @@ fn cell_pdf(scene: &CpuScene, params: &GpuRenderParams, c: &MapCell) -> f32 {
     p / cell_solid_angle(d, params, c.row)
 }
 
-/// A direction sampled from the map and its solid-angle density. Twin of WGSL
-/// `sample_env_map`.
+/// A direction sampled from the map, its solid-angle density, and the cell and position
+/// there that the direction points to (where [`cell_radiance`] gives the radiance seen along
+/// it: [`env_escape`]'s up to rounding, without turning the direction back into map
+/// coordinates). Twin of WGSL `sample_env_map`.
 #[inline(always)]
-pub fn sample_env_map(scene: &CpuScene, params: &GpuRenderParams, u: Vec2) -> (Vec3A, f32) {
+pub fn sample_env_map(
+    scene: &CpuScene,
+    params: &GpuRenderParams,
+    u: Vec2,
+) -> (Vec3A, f32, MapCell) {
     let d = scene.env_distribution;
     let w = params.env_width;
     let rows = params.env_height - 1;
@@ -206,9 +202,18 @@ pub fn sample_env_map(scene: &CpuScene, params: &GpuRenderParams, u: Vec2) -> (V
     }
     let (sin_phi, cos_phi) = sin_cos_turns(turns);
     let dir = Vec3A::new(sin_theta * sin_phi, cos_theta, -sin_theta * cos_phi);
+    // The texel position map_cell gives the direction: r1 of the way from column to column
+    // + 1; between the rows by the polar angle (map_uv's v times h - 1).
+    let y = acos(cos_theta.clamp(-1.0, 1.0)) * FRAC_1_PI * rows as f32;
+    let cell = MapCell {
+        column,
+        row,
+        f: Vec2::new(r1, (y - row as f32).clamp(0.0, 1.0)),
+    };
     (
         from_map(params, dir),
         p_row * p_column / cell_solid_angle(d, params, row),
+        cell,
     )
 }
 
@@ -223,7 +228,8 @@ pub fn env_pdf(scene: &CpuScene, params: &GpuRenderParams, n: Vec3A, wi: Vec3A) 
 }
 
 /// A direction towards the environment from a point with normal `n`, its density including
-/// the choice of the environment (`env_pmf`). Twin of WGSL `sample_environment`.
+/// the choice of the environment (`env_pmf`); a map's radiance is left to
+/// [`crate::lights::light_radiance`]. Twin of WGSL `sample_environment`.
 #[inline(always)]
 pub fn sample_environment(
     scene: &CpuScene,
@@ -232,16 +238,17 @@ pub fn sample_environment(
     u: Vec2,
 ) -> LightSample {
     if has_env_map(params) {
-        let (wi, pdf) = sample_env_map(scene, params, u);
+        let (wi, pdf, cell) = sample_env_map(scene, params, u);
         let pdf = params.env_pmf * pdf;
         return LightSample {
             wi,
             point: Vec3A::ZERO,
             finite: false,
-            radiance: env_radiance(scene, params, wi),
+            radiance: Vec3A::ZERO,
             pdf,
             valid: pdf > 0.0 && pdf.is_finite(),
             mis: true,
+            map_cell: Some(cell),
         };
     }
     let wi = Frame::around(n).to_world(sample_cosine_hemisphere(u));
@@ -255,6 +262,7 @@ pub fn sample_environment(
         pdf,
         valid: pdf > 0.0,
         mis: true,
+        map_cell: None,
     }
 }
 
@@ -329,7 +337,9 @@ mod tests {
                 (integral - 1.0).abs() < 2e-3,
                 "rotation {rotation}: {integral}"
             );
-            // Every sample's density is the density of its direction.
+            // Every sample's density is the density of its direction, and the radiance at
+            // its cell the radiance seen along it (to rounding: the texels reach 1000 and
+            // change by that much across a cell).
             let mut rng = 0x2545_f491_u32;
             let mut next = || {
                 rng ^= rng << 13;
@@ -338,8 +348,14 @@ mod tests {
                 (rng >> 8) as f32 / (1u32 << 24) as f32
             };
             for _ in 0..20_000 {
-                let (wi, pdf) = sample_env_map(&scene, &params, Vec2::new(next(), next()));
+                let (wi, pdf, cell) = sample_env_map(&scene, &params, Vec2::new(next(), next()));
                 assert!((wi.length() - 1.0).abs() < 1e-5);
+                let at_cell = cell_radiance(&scene, &params, &cell);
+                let along = env_escape(&scene, &params, Vec3A::ZERO, wi, false).0;
+                assert!(
+                    (at_cell - along).abs().max_element() <= 0.05,
+                    "rotation {rotation}: {at_cell} at the cell, {along} along {wi}"
+                );
                 let eval = env_map_pdf(&scene, &params, wi);
                 assert!(
                     (pdf - eval).abs() <= 2e-3 * pdf,
@@ -360,7 +376,7 @@ mod tests {
         for i in 0..n {
             for j in 0..n {
                 let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
-                let (wi, _) = sample_env_map(&scene, &params, u);
+                let (wi, _, _) = sample_env_map(&scene, &params, u);
                 let c = map_cell(&params, map_uv(to_map(&params, wi)));
                 counts[(c.row * w + c.column) as usize] += 1;
             }
@@ -410,7 +426,7 @@ mod tests {
                     -theta.sin() * phi.cos(),
                 );
                 let world = glam::Quat::from_rotation_y(rotation.to_radians()) * local;
-                env_radiance(&scene, &params, world.into())
+                env_escape(&scene, &params, Vec3A::ZERO, world.into(), false).0
             };
             let seen = seen_at(TAU * 11.5 / 16.0);
             let expected = Vec3A::new(500.0, 400.0, 300.0) * 2.0;
@@ -425,7 +441,15 @@ mod tests {
         // Straight up reads the top row, straight down the black bottom one.
         let (prepared, params) = sun_map(0.0);
         let scene = CpuScene::new(&prepared);
-        assert!(env_radiance(&scene, &params, Vec3A::Y).x > 0.0);
-        assert_eq!(env_radiance(&scene, &params, -Vec3A::Y), Vec3A::ZERO);
+        assert!(
+            env_escape(&scene, &params, Vec3A::ZERO, Vec3A::Y, false)
+                .0
+                .x
+                > 0.0
+        );
+        assert_eq!(
+            env_escape(&scene, &params, Vec3A::ZERO, -Vec3A::Y, false).0,
+            Vec3A::ZERO
+        );
     }
 }

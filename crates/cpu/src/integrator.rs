@@ -10,7 +10,7 @@ use crate::cpu_scene::CpuScene;
 use crate::environment::env_escape;
 use crate::intersect::Ray;
 use crate::light_sample::LightSample;
-use crate::lights::{light_pdf, sample_light};
+use crate::lights::{light_pdf, light_radiance, sample_light};
 use crate::material::{
     eval_material, has_continuous_material_lobe, material_absorption, material_albedo, material_at,
     sample_material,
@@ -235,7 +235,8 @@ impl Path {
                     } else {
                         1.0
                     };
-                    let radiance = self.throughput * e.f * ls.radiance * weight / ls.pdf;
+                    let radiance = light_radiance(scene, params, &ls);
+                    let radiance = self.throughput * e.f * radiance * weight / ls.pdf;
                     shadow = Some(ShadowTest {
                         ray,
                         t_max,

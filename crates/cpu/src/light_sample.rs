@@ -4,6 +4,8 @@
 
 use glam::Vec3A;
 
+use crate::environment::MapCell;
+
 /// A sampled light direction. Twin of WGSL `LightSample`.
 #[derive(Debug, Clone, Copy)]
 pub struct LightSample {
@@ -13,7 +15,7 @@ pub struct LightSample {
     pub point: Vec3A,
     /// False for the environment (infinitely far).
     pub finite: bool,
-    /// Emitted radiance towards the shading point.
+    /// Emitted radiance towards the shading point (zero when `map_cell` is set).
     pub radiance: Vec3A,
     /// Solid-angle density, including the choice of the light.
     pub pdf: f32,
@@ -23,6 +25,12 @@ pub struct LightSample {
     /// sampling (multiple importance sampling); false for point and sun lights, which
     /// only light samples reach.
     pub mis: bool,
+    /// For the environment map: the cell and position the sample points to, whose radiance
+    /// [`crate::lights::light_radiance`] looks up only once the BSDF is found to pass it on
+    /// (half of a map's samples fall below an opaque surface, and the lookup is two cache
+    /// misses in a large map). WGSL fills `radiance` at once: a GPU's lanes wait for one
+    /// another anyway.
+    pub map_cell: Option<MapCell>,
 }
 
 /// No sample. Twin of WGSL `invalid_light_sample`.
@@ -34,4 +42,5 @@ pub const INVALID: LightSample = LightSample {
     pdf: 0.0,
     valid: false,
     mis: true,
+    map_cell: None,
 };

@@ -10,7 +10,7 @@ use pathlight_core::gpu_types::{GpuRenderParams, KIND_MESH, LIGHT_POINT, LIGHT_S
 
 use crate::area_light::{area_light_pdf, sample_area_light};
 use crate::cpu_scene::CpuScene;
-use crate::environment::sample_environment;
+use crate::environment::{cell_radiance, sample_environment};
 use crate::light_sample::{INVALID, LightSample};
 use crate::point_light::sample_point_light;
 use crate::sampling::first_above;
@@ -71,5 +71,15 @@ pub fn sample_light(
         LIGHT_POINT => sample_point_light(scene, light.index, pmf, p, u),
         LIGHT_SUN => sample_sun_light(scene, light.index, pmf, u),
         _ => sample_area_light(scene, light.index, light.primitive, pmf, p, u, u_part),
+    }
+}
+
+/// The radiance `ls` brings: its own, or the environment map's at its cell (looked up now;
+/// WGSL `sample_environment` looks it up at once).
+#[inline(always)]
+pub fn light_radiance(scene: &CpuScene, params: &GpuRenderParams, ls: &LightSample) -> Vec3A {
+    match &ls.map_cell {
+        Some(cell) => cell_radiance(scene, params, cell),
+        None => ls.radiance,
     }
 }

@@ -67,5 +67,6 @@ pub fn sample_point_light(
         pdf,
         valid: falloff > 0.0 && pdf > 0.0 && pdf.is_finite() && radiance.is_finite(),
         mis: false,
+        map_cell: None,
     }
 }

@@ -37,5 +37,6 @@ pub fn sample_sun_light(scene: &CpuScene, block: u32, pmf: f32, u: Vec2) -> Ligh
         pdf,
         valid: pdf > 0.0 && pdf.is_finite(),
         mis: false,
+        map_cell: None,
     }
 }

@@ -76,15 +76,6 @@ fn map_cell(uv: vec2f) -> MapCell {
     return MapCell(column, row, vec2f(x - f32(column), y - f32(row)));
 }
 
-// Radiance arriving along -dir, i.e. seen looking along world direction `dir`.
-// CPU twin: `env_radiance`.
-fn env_radiance(dir: vec3f) -> vec3f {
-    if !has_env_map() {
-        return params.environment;
-    }
-    return cell_radiance(map_cell(map_uv(to_map(dir))));
-}
-
 // What a path escaping along world direction `dir` from a point of normal `n` sees: the
 // radiance and, when `mis`, the density `env_pdf` gives the direction (0 otherwise), the
 // map's coordinates computed once.
@@ -161,10 +152,13 @@ fn cell_pdf(c: MapCell) -> f32 {
     return p / cell_solid_angle(c.row);
 }
 
-// A direction sampled from the map, with its solid-angle density.
+// A direction sampled from the map, its solid-angle density and the radiance seen along it
+// (the map's at the cell and position sampled, without turning the direction back into map
+// coordinates).
 struct EnvSample {
     wi: vec3f,
     pdf: f32,
+    radiance: vec3f,
 }
 
 // CPU twin: `sample_env_map`.
@@ -188,7 +182,11 @@ fn sample_env_map(u: vec2f) -> EnvSample {
     turns = select(turns, turns - 1.0, turns >= 1.0);
     let phi = TAU * turns;
     let d = vec3f(sin_theta * sin(phi), cos_theta, -sin_theta * cos(phi));
-    return EnvSample(from_map(d), p_row * p_column / cell_solid_angle(row));
+    // The texel position map_cell gives the direction: r1 of the way from column to column
+    // + 1; between the rows by the polar angle (map_uv's v times h - 1).
+    let y = acos(clamp(cos_theta, -1.0, 1.0)) * INV_PI * f32(rows);
+    let cell = MapCell(column, row, vec2f(r1, clamp(y - f32(row), 0.0, 1.0)));
+    return EnvSample(from_map(d), p_row * p_column / cell_solid_angle(row), cell_radiance(cell));
 }
 
 // Density of choosing the environment and direction `wi` from a point with normal `n` (on
@@ -208,7 +206,7 @@ fn sample_environment(n: vec3f, u: vec2f) -> LightSample {
     if has_env_map() {
         let es = sample_env_map(u);
         let pdf = params.env_pmf * es.pdf;
-        return LightSample(es.wi, vec3f(0.0), false, env_radiance(es.wi), pdf, pdf > 0.0 && pdf <= 3.0e38, true);
+        return LightSample(es.wi, vec3f(0.0), false, es.radiance, pdf, pdf > 0.0 && pdf <= 3.0e38, true);
     }
     let wi = frame_around(n) * sample_cosine_hemisphere(u);
     let pdf = env_pdf(n, wi);
