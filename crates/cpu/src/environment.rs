@@ -115,6 +115,22 @@ pub fn cell_radiance(scene: &CpuScene, params: &GpuRenderParams, c: &MapCell) ->
     (v0 * (1.0 - c.f.y) + v1 * c.f.y) * params.env_scale
 }
 
+/// Asks for the cache line of `values[i]` (if any) to be loaded ahead of its use, so that
+/// its miss overlaps other work: the map's tables are megabytes, read at random.
+#[inline(always)]
+fn prefetch<T>(values: &[T], i: usize) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(value) = values.get(i) {
+        // SAFETY: a prefetch reads nothing and cannot fault; the address is `value`'s.
+        unsafe {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            _mm_prefetch::<_MM_HINT_T0>(std::ptr::from_ref(value).cast());
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (values, i);
+}
+
 /// Probability of entry `k` of the CDF at `start`. Twin of WGSL `cdf_pmf`.
 #[inline(always)]
 fn cdf_pmf(d: &[f32], start: u32, k: u32) -> f32 {
@@ -133,7 +149,11 @@ fn cdf_pmf(d: &[f32], start: u32, k: u32) -> f32 {
 #[inline(always)]
 fn cdf_search(scene: &CpuScene, start: u32, n: u32, guide: u32, u: f32) -> u32 {
     let cdf = &scene.env_distribution[start as usize..(start + n) as usize];
-    let k = (guide + guide_bucket(u, n)) as usize;
+    let bucket = guide_bucket(u, n);
+    // The entry sought usually lies near the bucket's position: its line is loaded while
+    // the guide's is.
+    prefetch(cdf, bucket as usize);
+    let k = (guide + bucket) as usize;
     let (lo, hi) = (
         u32::from(scene.env_guides[k]),
         u32::from(scene.env_guides[k + 1]),
@@ -190,6 +210,10 @@ pub fn sample_env_map(
     let start = rows + params.env_height + row * w;
     let column = cdf_search(scene, start, w, rows + 1 + row * (w + 1), u1);
     let p_column = cdf_pmf(d, start, column);
+    // The texels of the cell, loaded while the BSDF is evaluated (`light_radiance` reads them).
+    let top = (row * w + column) as usize;
+    prefetch(scene.env_texels, top);
+    prefetch(scene.env_texels, top + w as usize);
     let r0 = ((u0 - (d[row as usize] - p_row)) / p_row).clamp(0.0, 1.0);
     let r1 = ((u1 - (d[(start + column) as usize] - p_column)) / p_column).clamp(0.0, 1.0);
     let cos0 = d[(rows + row) as usize];
