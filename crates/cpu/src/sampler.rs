@@ -106,12 +106,22 @@ impl Sampler {
     /// Sample `index` of `pixel` under `seed`, of kind `SAMPLER_*`. Twin of WGSL `sampler_init`.
     #[inline(always)]
     pub fn new(kind: u32, pixel: u32, index: u32, seed: u32) -> Self {
+        // Each kind hashes only the state it reads (WGSL hashes both).
+        let sobol = kind == SAMPLER_SOBOL;
         Self {
             kind,
-            pixel_seed: pcg_hash(pixel ^ pcg_hash(seed)),
+            pixel_seed: if sobol {
+                pcg_hash(pixel ^ pcg_hash(seed))
+            } else {
+                0
+            },
             index_reversed: index.reverse_bits(),
             dimension: 0,
-            rng_state: rng_init(pixel, index, seed),
+            rng_state: if sobol {
+                0
+            } else {
+                rng_init(pixel, index, seed)
+            },
             ahead: [Vec2::ZERO; LANES],
             ahead_from: u32::MAX,
         }
