@@ -4,6 +4,7 @@ use glam::{Vec2, Vec3A};
 use pathlight_core::gpu_types::GpuRenderParams;
 
 use crate::intersect::Ray;
+use crate::packet::PACKET;
 use crate::sampler::Sampler;
 use crate::sampling::sample_disk;
 
@@ -27,17 +28,46 @@ pub fn primary_ray(params: &GpuRenderParams, film: Vec2) -> Ray {
     )
 }
 
-/// The camera ray through a jittered point of pixel (x, y): a box-filtered sample, from a
-/// uniform point of the lens towards the plane in focus when there is a lens (a pinhole
-/// draws no lens sample). Twin of WGSL `camera_ray`.
+/// The pinhole rays' unit directions, per axis, through film points `(x[l], y[l])` of
+/// [`PACKET`] lanes side by side: [`primary_ray`]'s bit for bit (per lane the same operations
+/// in the same order), computed in SIMD lanes, so that a packet's new paths do not each wait
+/// on their own division and square root.
 #[inline(always)]
-pub fn camera_ray(params: &GpuRenderParams, x: u32, y: u32, sampler: &mut Sampler) -> Ray {
-    let jitter = sampler.next_2d();
-    let film = Vec2::new(x as f32 + jitter.x, y as f32 + jitter.y);
+pub fn primary_directions(
+    params: &GpuRenderParams,
+    x: &[f32; PACKET],
+    y: &[f32; PACKET],
+) -> [[f32; PACKET]; 3] {
     let c = &params.camera;
-    if c.lens_radius <= 0.0 {
-        return primary_ray(params, film);
+    let (width, height) = (params.width as f32, params.height as f32);
+    let mut dir = [[0.0; PACKET]; 3];
+    for l in 0..PACKET {
+        let ndc_x = 2.0 * x[l] / width - 1.0;
+        let ndc_y = 1.0 - 2.0 * y[l] / height;
+        let v: [f32; 3] =
+            std::array::from_fn(|a| c.forward[a] + ndc_x * c.right[a] + ndc_y * c.up[a]);
+        // glam's `normalize`: the dot product summed x, y, then z; a division by its root.
+        let length = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        for a in 0..3 {
+            dir[a][l] = v[a] / length;
+        }
     }
+    dir
+}
+
+/// The jittered point of film a sample of pixel (x, y) aims through (the sampler's next
+/// point: a box filter).
+#[inline(always)]
+pub fn film_point(x: u32, y: u32, sampler: &mut Sampler) -> Vec2 {
+    let jitter = sampler.next_2d();
+    Vec2::new(x as f32 + jitter.x, y as f32 + jitter.y)
+}
+
+/// The ray through film point `film` of a camera with a lens: from a uniform point of the
+/// lens (drawn from `sampler`) towards the plane in focus.
+#[inline(always)]
+pub fn lens_ray(params: &GpuRenderParams, film: Vec2, sampler: &mut Sampler) -> Ray {
+    let c = &params.camera;
     let lens = sample_disk(sampler.next_2d()) * c.lens_radius;
     let position = Vec3A::from(c.position);
     let origin = position
@@ -45,6 +75,18 @@ pub fn camera_ray(params: &GpuRenderParams, x: u32, y: u32, sampler: &mut Sample
         + lens.y * Vec3A::from(c.up).normalize();
     let focus = position + film_direction(params, film) * c.focus_distance;
     Ray::new(origin, (focus - origin).normalize())
+}
+
+/// The camera ray through a jittered point of pixel (x, y): a box-filtered sample, from a
+/// uniform point of the lens towards the plane in focus when there is a lens (a pinhole
+/// draws no lens sample). Twin of WGSL `camera_ray`.
+#[inline(always)]
+pub fn camera_ray(params: &GpuRenderParams, x: u32, y: u32, sampler: &mut Sampler) -> Ray {
+    let film = film_point(x, y, sampler);
+    if params.camera.lens_radius <= 0.0 {
+        return primary_ray(params, film);
+    }
+    lens_ray(params, film, sampler)
 }
 
 #[cfg(test)]
@@ -65,6 +107,45 @@ mod tests {
         scene.camera.focus_distance = focus_distance;
         let prepared = pathlight_core::PreparedScene::new(&scene).unwrap();
         GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading)
+    }
+
+    /// The lane-wise directions are `primary_ray`'s bit for bit, at film points across the
+    /// image, its corners and edges, and beyond them.
+    #[test]
+    fn lanes_aim_as_primary_ray_bit_for_bit() {
+        let params = params(0.0, 1.0);
+        let mut state = 0x9e37_79b9_u32;
+        for round in 0..64 {
+            let (mut x, mut y) = ([0.0; PACKET], [0.0; PACKET]);
+            for l in 0..PACKET {
+                state ^= state << 13;
+                state ^= state >> 17;
+                state ^= state << 5;
+                let u = state as f32 / 4_294_967_296.0;
+                x[l] = if round == 0 {
+                    [0.0, 40.0, -3.0, 41.5][l % 4]
+                } else {
+                    u * 46.0 - 3.0
+                };
+                y[l] = if round == 0 {
+                    [0.0, 30.0, 30.0, -0.5][l % 4]
+                } else {
+                    (1.0 - u) * 36.0 - 3.0
+                };
+            }
+            let dir = primary_directions(&params, &x, &y);
+            for l in 0..PACKET {
+                let single = primary_ray(&params, Vec2::new(x[l], y[l])).dir;
+                let lane = Vec3::new(dir[0][l], dir[1][l], dir[2][l]);
+                assert_eq!(
+                    lane.to_array().map(f32::to_bits),
+                    single.to_array().map(f32::to_bits),
+                    "({}, {})",
+                    x[l],
+                    y[l]
+                );
+            }
+        }
     }
 
     #[test]

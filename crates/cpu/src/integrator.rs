@@ -112,6 +112,13 @@ impl Path {
     #[inline(always)]
     pub fn new(params: &GpuRenderParams, x: u32, y: u32, mut sampler: Sampler) -> Self {
         let ray = camera_ray(params, x, y, &mut sampler);
+        Self::from_camera_ray(params, ray, sampler)
+    }
+
+    /// The path starting on camera ray `ray`, with `sampler` past the dimensions the ray
+    /// drew ([`camera_ray`]'s).
+    #[inline(always)]
+    pub fn from_camera_ray(params: &GpuRenderParams, ray: Ray, sampler: Sampler) -> Self {
         Self {
             ray,
             alive: params.max_depth > 0,

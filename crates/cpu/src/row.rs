@@ -3,12 +3,14 @@
 
 use std::ops::Range;
 
-use glam::Vec3A;
+use glam::{Vec3, Vec3A};
 use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams};
 
+use crate::camera::{film_point, lens_ray, primary_directions};
 use crate::cpu_scene::CpuScene;
 use crate::integrator::{Path, T_MAX, accumulated_value, add_aov_sample, add_sample};
-use crate::packet::{PACKET, RayPacket};
+use crate::intersect::Ray;
+use crate::packet::{Lanes, PACKET, RayPacket};
 use crate::sampler::Sampler;
 use crate::tracer::Tracer;
 
@@ -61,9 +63,7 @@ impl std::iter::Sum for Tally {
 #[inline(always)]
 fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
     let (scene, params) = (job.scene, job.params);
-    let samples_per_pixel = job.samples.len();
-    let sample_count = row.color.len() * samples_per_pixel;
-    let mut next_sample = 0;
+    let mut starter = Starter::new(job, row.color.len());
     let mut lanes: [Option<(usize, Path)>; PACKET] = std::array::from_fn(|_| None);
     let mut tally = Tally::default();
     // Reused from round to round: only the lanes in use are written.
@@ -74,32 +74,13 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
     let mut shadows = RayPacket::default();
     loop {
         packet.active = 0;
-        for (l, lane) in lanes.iter_mut().enumerate() {
+        for (l, lane) in lanes.iter().enumerate() {
             if let Some((_, path)) = lane {
                 packet.rays[l] = path.ray;
                 packet.active |= 1 << l;
-                continue;
-            }
-            while next_sample < sample_count {
-                let x = next_sample / samples_per_pixel;
-                let i = job.samples.start + (next_sample % samples_per_pixel) as u32;
-                next_sample += 1;
-                let pixel = job.y * params.width + x as u32;
-                let sampler = Sampler::new(params.sampler, pixel, i, params.seed);
-                let path = Path::new(params, x as u32, job.y, sampler);
-                if path.alive {
-                    // The new ray written from the path in hand: read back from the path
-                    // just stored in the lane, its bytes would straddle separate stores,
-                    // which the CPU cannot forward (a stall of every new path, 8% of a
-                    // furnace's profile).
-                    packet.rays[l] = path.ray;
-                    packet.active |= 1 << l;
-                    *lane = Some((x, path));
-                    break;
-                }
-                tally = tally + finish(&path, row, x);
             }
         }
+        tally = tally + starter.fill(&mut lanes, &mut packet, row);
         if packet.active == 0 {
             return tally;
         }
@@ -125,6 +106,109 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
             if !path.alive {
                 tally = tally + finish(path, row, *x);
                 *lane = None;
+            }
+        }
+    }
+}
+
+/// The samples of a row still to start (pixel by pixel, each pixel's in turn), and what
+/// starting them needs: a new path's sampler and film point are drawn lane by lane, then (for
+/// a pinhole) the camera rays of all the lanes starting at once, side by side, so that new
+/// paths do not each wait on a division and a square root.
+struct Starter<'a> {
+    job: &'a RowJob<'a>,
+    samples_per_pixel: usize,
+    /// Samples in the row, and the next to start.
+    count: usize,
+    next: usize,
+    pinhole: bool,
+    /// Per lane, of the sample starting there: its pixel column and sampler, its film
+    /// point (for a pinhole) or camera ray (with a lens).
+    starts: [(usize, Sampler); PACKET],
+    film_x: [f32; PACKET],
+    film_y: [f32; PACKET],
+    lens_rays: [Ray; PACKET],
+}
+
+impl<'a> Starter<'a> {
+    #[inline(always)]
+    fn new(job: &'a RowJob<'a>, width: usize) -> Self {
+        let params = job.params;
+        let samples_per_pixel = job.samples.len();
+        Self {
+            job,
+            samples_per_pixel,
+            count: width * samples_per_pixel,
+            next: 0,
+            pinhole: params.camera.lens_radius <= 0.0,
+            starts: std::array::from_fn(|_| (0, Sampler::new(params.sampler, 0, 0, 0))),
+            film_x: [0.0; PACKET],
+            film_y: [0.0; PACKET],
+            lens_rays: RayPacket::default().rays,
+        }
+    }
+
+    /// Starts the next samples in the empty lanes of `lanes`, their camera rays into
+    /// `packet`; a path that ends at once (max_depth 0) is added to `row` and hands its lane
+    /// to the next sample. Returns what those did.
+    #[inline(always)]
+    fn fill(
+        &mut self,
+        lanes: &mut [Option<(usize, Path)>; PACKET],
+        packet: &mut RayPacket,
+        row: &mut RowSums,
+    ) -> Tally {
+        let (job, params) = (self.job, self.job.params);
+        let mut tally = Tally::default();
+        loop {
+            let mut starting: Lanes = 0;
+            for (l, lane) in lanes.iter().enumerate() {
+                if lane.is_some() || self.next == self.count {
+                    continue;
+                }
+                let x = self.next / self.samples_per_pixel;
+                let i = job.samples.start + (self.next % self.samples_per_pixel) as u32;
+                self.next += 1;
+                let pixel = job.y * params.width + x as u32;
+                let mut sampler = Sampler::new(params.sampler, pixel, i, params.seed);
+                let film = film_point(x as u32, job.y, &mut sampler);
+                if self.pinhole {
+                    (self.film_x[l], self.film_y[l]) = (film.x, film.y);
+                } else {
+                    self.lens_rays[l] = lens_ray(params, film, &mut sampler);
+                }
+                self.starts[l] = (x, sampler);
+                starting |= 1 << l;
+            }
+            if starting == 0 {
+                return tally;
+            }
+            let dir = self
+                .pinhole
+                .then(|| primary_directions(params, &self.film_x, &self.film_y));
+            let mut left = starting;
+            while left != 0 {
+                let l = left.trailing_zeros() as usize;
+                left &= left - 1;
+                let ray = match &dir {
+                    Some(dir) => Ray::new(
+                        params.camera.position,
+                        Vec3::new(dir[0][l], dir[1][l], dir[2][l]),
+                    ),
+                    None => self.lens_rays[l],
+                };
+                let (x, sampler) = self.starts[l].clone();
+                let path = Path::from_camera_ray(params, ray, sampler);
+                if path.alive {
+                    packet.rays[l] = ray;
+                    packet.active |= 1 << l;
+                    lanes[l] = Some((x, path));
+                } else {
+                    tally = tally + finish(&path, row, x);
+                }
+            }
+            if params.max_depth > 0 {
+                return tally; // Every new path lives: a lane stays empty only for want of samples.
             }
         }
     }
