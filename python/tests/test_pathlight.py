@@ -224,8 +224,11 @@ def test_auxiliary_images_and_denoising():
 
 
 def test_ctrl_c_stops_a_long_render_keeping_its_samples():
+    # A child started from a background job of a non-interactive shell inherits SIGINT
+    # ignored, and Python then installs no handler of its own: restore it, as a terminal has.
     script = textwrap.dedent(f"""
-        import sys, pathlight
+        import signal, sys, pathlight
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         renderer = pathlight.Renderer(pathlight.default_scene(), backend="cpu", width=200,
                                       height=200)
         renderer.step(1)
