@@ -22,6 +22,36 @@ const WAVE_PATHS: u64 = 1 << 20;
 const FIELDS: u64 = 10;
 const FIELDS_WITH_AOVS: u64 = 13;
 
+/// Rows of a `width` x `height` image one wave holds on a device with `limits`, each path's
+/// state `fields` vec4s: the whole image, or several samples of it when it is small, as the
+/// limits allow; or why the device cannot hold one row.
+fn wave_rows(
+    limits: &wgpu::Limits,
+    (width, height): (u32, u32),
+    fields: u64,
+) -> Result<u32, RenderError> {
+    // The trace kernel's workgroups: at most 1 + ceil(shadows / 64) + ceil(extensions / 64)
+    // <= 3 + paths / 32, under the limit of a dispatch; the state under a binding's.
+    let by_dispatch = u64::from(
+        limits
+            .max_compute_workgroups_per_dimension
+            .saturating_sub(3)
+            / 2,
+    ) * u64::from(QUEUE_WORKGROUP);
+    let by_binding = limits.max_storage_buffer_binding_size / (fields * 16);
+    let paths = (u64::from(width) * u64::from(height)).max(WAVE_PATHS);
+    let rows = paths.min(by_dispatch).min(by_binding) / u64::from(width.max(1));
+    if rows == 0 {
+        return Err(RenderError::Limits(format!(
+            "a row of {width} pixels does not fit the wavefront's path state on this device \
+             (at most {} paths); use the megakernel",
+            by_dispatch.min(by_binding)
+        )));
+    }
+    // At most WAVE_PATHS or the image's pixels, whichever is more: below 2^32 rows.
+    Ok(rows as u32)
+}
+
 /// The wavefront kernels of a scene and the path state they share.
 #[derive(Debug)]
 pub struct Wavefront {
@@ -53,27 +83,8 @@ impl Wavefront {
         aovs: bool,
     ) -> Result<Self, RenderError> {
         let fields = if aovs { FIELDS_WITH_AOVS } else { FIELDS };
-        let limits = device.limits();
-        // The trace kernel's workgroups: at most 1 + ceil(shadows / 64) + ceil(extensions / 64)
-        // <= 3 + paths / 32, under the limit of a dispatch; the state under a binding's.
-        let by_dispatch = u64::from(
-            limits
-                .max_compute_workgroups_per_dimension
-                .saturating_sub(3)
-                / 2,
-        ) * u64::from(QUEUE_WORKGROUP);
-        let by_binding = limits.max_storage_buffer_binding_size / (fields * 16);
-        // The whole image, or several samples of it when it is small (whole rows).
-        let paths = (u64::from(width) * u64::from(height)).max(WAVE_PATHS);
-        let rows = paths.min(by_dispatch).min(by_binding) / u64::from(width);
-        if rows == 0 {
-            return Err(RenderError::Limits(format!(
-                "a row of {width} pixels does not fit the wavefront's path state on this device \
-                 (at most {} paths); use the megakernel",
-                by_dispatch.min(by_binding)
-            )));
-        }
-        let capacity = rows as u32 * width;
+        let rows = wave_rows(&device.limits(), (width, height), fields)?;
+        let capacity = rows * width;
         let mut constants = kernel.constants.clone();
         constants.push(("CAPACITY", f64::from(capacity)));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -137,7 +148,7 @@ impl Wavefront {
             counts,
             dispatches,
             dispatch_groups,
-            rows: rows as u32,
+            rows,
         })
     }
 
@@ -195,5 +206,56 @@ impl Wavefront {
             pass.set_pipeline(&self.finish);
             pass.dispatch_workgroups(grid.0, grid.1, 1);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A device's limits with `bytes` for a storage binding and `groups` workgroups a
+    /// dispatch dimension.
+    fn limits(bytes: u64, groups: u32) -> wgpu::Limits {
+        wgpu::Limits {
+            max_storage_buffer_binding_size: bytes,
+            max_compute_workgroups_per_dimension: groups,
+            ..wgpu::Limits::default()
+        }
+    }
+
+    #[test]
+    fn a_wave_holds_whole_rows_within_the_limits() {
+        let roomy = limits(1 << 40, 1 << 30);
+        // A small image: the wave holds several samples of it, in whole rows.
+        assert_eq!(
+            wave_rows(&roomy, (100, 50), FIELDS).ok(),
+            Some((1 << 20) / 100)
+        );
+        // A large one: all of it.
+        assert_eq!(wave_rows(&roomy, (4000, 3000), FIELDS).ok(), Some(3000));
+        // The binding's limit: 1 MiB of 160-byte paths is 6553 paths, 65 rows of 100.
+        let small_binding = limits(1 << 20, 1 << 30);
+        assert_eq!(wave_rows(&small_binding, (100, 50), FIELDS).ok(), Some(65));
+        // Auxiliary images make a path's state larger: 5041 paths, 50 rows.
+        assert_eq!(
+            wave_rows(&small_binding, (100, 50), FIELDS_WITH_AOVS).ok(),
+            Some(50)
+        );
+        // The dispatch's limit: (1003 - 3) / 2 * 64 = 32000 paths, 320 rows.
+        let few_groups = limits(1 << 40, 1003);
+        assert_eq!(wave_rows(&few_groups, (100, 50), FIELDS).ok(), Some(320));
+    }
+
+    #[test]
+    fn a_row_too_wide_for_the_device_is_refused_with_its_width() {
+        let small_binding = limits(1 << 20, 1 << 30);
+        let error = wave_rows(&small_binding, (7000, 10), FIELDS).unwrap_err();
+        let text = error.to_string();
+        assert!(matches!(error, RenderError::Limits(_)), "{text}");
+        assert!(
+            text.contains("a row of 7000 pixels") && text.contains("at most 6553 paths"),
+            "{text}"
+        );
+        assert!(text.contains("use the megakernel"), "{text}");
     }
 }
