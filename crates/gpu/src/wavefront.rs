@@ -24,7 +24,8 @@ const FIELDS_WITH_AOVS: u64 = 13;
 
 /// Rows of a `width` x `height` image one wave holds on a device with `limits`, each path's
 /// state `fields` vec4s: the whole image, or several samples of it when it is small, as the
-/// limits allow; or why the device cannot hold one row.
+/// limits allow; or why the device cannot hold one row. `width` is at least 1 (the scene's
+/// settings refuse a resolution outside 1..=`MAX_RESOLUTION`).
 fn wave_rows(
     limits: &wgpu::Limits,
     (width, height): (u32, u32),
@@ -40,7 +41,7 @@ fn wave_rows(
     ) * u64::from(QUEUE_WORKGROUP);
     let by_binding = limits.max_storage_buffer_binding_size / (fields * 16);
     let paths = (u64::from(width) * u64::from(height)).max(WAVE_PATHS);
-    let rows = paths.min(by_dispatch).min(by_binding) / u64::from(width.max(1));
+    let rows = paths.min(by_dispatch).min(by_binding) / u64::from(width);
     if rows == 0 {
         return Err(RenderError::Limits(format!(
             "a row of {width} pixels does not fit the wavefront's path state on this device \
