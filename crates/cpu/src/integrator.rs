@@ -7,14 +7,16 @@ use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams, NO_
 use crate::bvh::Hit;
 use crate::camera::camera_ray;
 use crate::cpu_scene::CpuScene;
+use crate::diffuse::DiffuseLanes;
 use crate::environment::env_escape;
 use crate::intersect::Ray;
 use crate::light_sample::LightSample;
 use crate::lights::{light_pdf, light_radiance, sample_light};
 use crate::material::{
-    eval_material, has_continuous_material_lobe, material_absorption, material_albedo, material_at,
-    sample_material,
+    eval_material, has_continuous_material_lobe, is_lambert, material_absorption, material_albedo,
+    material_at, sample_material,
 };
+use crate::microfacet::BsdfSample;
 use crate::sampler::{Draw, Sampler};
 use crate::sampling::power_heuristic;
 use crate::surface::surface_at;
@@ -143,13 +145,17 @@ impl Path {
 
     /// Goes on from `hit`, the nearest hit of [`Path::ray`]: adds what the path sees there,
     /// samples a light (returning its shadow ray, for the caller to trace and
-    /// [`Path::add_unblocked`]) and the BSDF (the next ray), or ends the path.
+    /// [`Path::add_unblocked`]) and the BSDF (the next ray), or ends the path. On a purely
+    /// diffuse surface the BSDF sample is left to `diffuse` as lane `lane`: once
+    /// [`DiffuseLanes::sample`] ran, [`Path::leave_diffuse`] goes on.
     #[inline(always)]
     pub fn step(
         &mut self,
         scene: &CpuScene,
         params: &GpuRenderParams,
         hit: Option<Hit>,
+        diffuse: &mut DiffuseLanes,
+        lane: usize,
     ) -> Option<ShadowTest> {
         self.depth += 1;
         self.sample.rays += 1;
@@ -235,13 +241,13 @@ impl Path {
             if ls.valid {
                 let e = eval_material(material, &s, wo, ls.wi);
                 if e.f.max_element() > 0.0 {
-                    self.sample.rays += 1;
                     let (ray, t_max) = shadow_ray(s.position, s.ng, &ls);
                     let weight = if ls.mis {
                         power_heuristic(ls.pdf, e.pdf)
                     } else {
                         1.0
                     };
+                    self.sample.rays += 1;
                     let radiance = light_radiance(scene, params, &ls);
                     let radiance = self.throughput * e.f * radiance * weight / ls.pdf;
                     shadow = Some(ShadowTest {
@@ -252,10 +258,41 @@ impl Path {
                 }
             }
         }
+        if is_lambert(material) {
+            let ng = if wo.dot(s.ng) >= 0.0 { s.ng } else { -s.ng };
+            let color = material.base_color;
+            diffuse.push(lane, s.position, n, ng, wo, color, u_bsdf, u_rr);
+            return shadow;
+        }
         let bs = sample_material(material, &s, wo, u_lobe, u_fresnel, u_bsdf);
+        self.bounce(params, &bs, s.position, s.ng, n, u_rr);
+        shadow
+    }
+
+    /// Goes on from the diffuse vertex that lane `lane` of `diffuse` holds, once
+    /// [`DiffuseLanes::compute`] ran.
+    #[inline(always)]
+    pub fn leave_diffuse(&mut self, params: &GpuRenderParams, diffuse: &DiffuseLanes, lane: usize) {
+        let v = diffuse.vertex(lane);
+        self.bounce(params, &v.sample, v.position, v.ng, v.n, v.u_rr);
+    }
+
+    /// Goes on along BSDF sample `bs`, drawn at `position` (geometric normal `ng`, shading
+    /// normal `n` on the side of wo), `u_rr` deciding Russian roulette: the next ray, or the
+    /// end of the path.
+    #[inline(always)]
+    fn bounce(
+        &mut self,
+        params: &GpuRenderParams,
+        bs: &BsdfSample,
+        position: Vec3A,
+        ng: Vec3A,
+        n: Vec3A,
+        u_rr: f32,
+    ) {
         if !bs.valid {
             self.end();
-            return shadow;
+            return;
         }
         if self.aov_pending {
             // A perfect mirror or glass passes on what it reflects or transmits (without
@@ -266,19 +303,18 @@ impl Path {
         self.throughput *= bs.weight;
         self.prev_pdf = bs.pdf;
         self.prev_delta = bs.delta;
-        self.prev_position = s.position;
+        self.prev_position = position;
         self.prev_normal = n;
         self.eta_scale *= bs.eta;
         if self.depth >= params.rr_depth {
             let q = (self.throughput.max_element() * self.eta_scale * self.eta_scale).min(0.95);
             if u_rr >= q {
                 self.end();
-                return shadow;
+                return;
             }
             self.throughput /= q;
         }
-        self.ray = Ray::new(offset_origin(s.position, s.ng, bs.wi), bs.wi);
-        shadow
+        self.ray = Ray::new(offset_origin(position, ng, bs.wi), bs.wi);
     }
 
     /// Ends the path on a surface; if the auxiliary images found none but perfect mirrors
@@ -311,9 +347,16 @@ pub fn trace_path(
     sampler: Sampler,
 ) -> PathSample {
     let mut path = Path::new(params, x, y, sampler);
+    let mut diffuse = DiffuseLanes::default();
     while path.alive {
         let hit = tracer.intersect(&path.ray, T_MAX);
-        if let Some(shadow) = path.step(scene, params, hit)
+        diffuse.mask = 0;
+        let shadow = path.step(scene, params, hit, &mut diffuse, 0);
+        if diffuse.mask != 0 {
+            diffuse.compute();
+            path.leave_diffuse(params, &diffuse, 0);
+        }
+        if let Some(shadow) = shadow
             && !tracer.occluded(&shadow.ray, shadow.t_max)
         {
             path.add_unblocked(shadow.radiance);

@@ -9,6 +9,7 @@ pub mod area_light;
 pub mod bvh;
 pub mod camera;
 pub mod cpu_scene;
+pub mod diffuse;
 pub mod display;
 pub mod environment;
 pub mod integrator;

@@ -67,6 +67,12 @@ impl LobesParams {
             k: p[3].truncate().into(),
         }
     }
+
+    /// Whether the Lambert lobe is the only one (weight 1): [`crate::diffuse`] samples it.
+    #[inline(always)]
+    pub fn is_lambert(&self) -> bool {
+        self.specular_rate == 0.0 && self.refract_rate == 0.0
+    }
 }
 
 /// Reflectance of the specular lobe at `cos_i`. Twin of WGSL `specular_reflectance`.

@@ -161,6 +161,13 @@ pub fn material_absorption(p: &MaterialPoint) -> Vec3A {
     }
 }
 
+/// Whether the material is purely diffuse: the lobes model with its Lambert lobe alone
+/// ([`LobesParams::is_lambert`]).
+#[inline(always)]
+pub fn is_lambert(p: &MaterialPoint) -> bool {
+    p.model != MODEL_METAL_ROUGH && LobesParams::decode(&p.params).is_lambert()
+}
+
 /// Whether the BSDF has a non-delta lobe (next-event estimation is worth doing). Twin of
 /// WGSL `has_continuous_material_lobe`.
 #[inline(always)]

@@ -8,6 +8,7 @@ use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams};
 
 use crate::camera::{film_point, lens_ray, primary_directions};
 use crate::cpu_scene::CpuScene;
+use crate::diffuse::DiffuseLanes;
 use crate::integrator::{Path, T_MAX, accumulated_value, add_aov_sample, add_sample};
 use crate::intersect::Ray;
 use crate::packet::{Lanes, PACKET, RayPacket};
@@ -72,6 +73,7 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
         ..RayPacket::default()
     };
     let mut shadows = RayPacket::default();
+    let mut diffuse = DiffuseLanes::default();
     loop {
         packet.active = 0;
         for (l, lane) in lanes.iter().enumerate() {
@@ -87,14 +89,26 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
         let hits = tracer.intersect_packet(&packet);
         shadows.active = 0;
         let mut unblocked = [Vec3A::ZERO; PACKET];
+        diffuse.mask = 0;
         for (l, lane) in lanes.iter_mut().enumerate() {
             if let Some((_, path)) = lane
-                && let Some(shadow) = path.step(scene, params, hits.hit(l))
+                && let Some(shadow) = path.step(scene, params, hits.hit(l), &mut diffuse, l)
             {
                 shadows.rays[l] = shadow.ray;
                 shadows.t_max[l] = shadow.t_max;
                 shadows.active |= 1 << l;
                 unblocked[l] = shadow.radiance;
+            }
+        }
+        if diffuse.mask != 0 {
+            diffuse.compute();
+            let mut left = diffuse.mask;
+            while left != 0 {
+                let l = left.trailing_zeros() as usize;
+                left &= left - 1;
+                if let Some((_, path)) = &mut lanes[l] {
+                    path.leave_diffuse(params, &diffuse, l);
+                }
             }
         }
         let blocked = tracer.occluded_packet(&shadows);
