@@ -8,6 +8,9 @@ use std::f32::consts::FRAC_1_PI;
 
 use glam::{Vec2, Vec3A};
 
+use crate::cpu_scene::CpuScene;
+use crate::integrator::ShadowTest;
+use crate::intersect::Ray;
 use crate::microfacet::{BsdfSample, INVALID};
 use crate::packet::{Lanes, PACKET};
 use crate::sampling::sin_cos_turns;
@@ -18,6 +21,9 @@ type Lanes3 = [[f32; PACKET]; 3];
 /// A diffuse vertex with its BSDF sample, and what the path needs to go on from it.
 #[derive(Debug, Clone, Copy)]
 pub struct DiffuseVertex {
+    /// The shadow test of its quad light's sample ([`DiffuseLanes::push_quad_light`]), unless
+    /// the BSDF passes nothing of it on.
+    pub shadow: Option<ShadowTest>,
     /// The BSDF sample.
     pub sample: BsdfSample,
     /// The vertex.
@@ -46,7 +52,23 @@ pub struct DiffuseLanes {
     /// The two dimensions the BSDF direction is drawn from, and Russian roulette's.
     u: [[f32; PACKET]; 2],
     u_rr: [f32; PACKET],
+    /// Bit `l` set: lane `l`'s light sample is on a quad light, and waits too
+    /// ([`DiffuseLanes::push_quad_light`]).
+    pub quad_light: Lanes,
+    /// The quad (corner, edges, unit normal, area), the probability of having chosen it, its
+    /// radiance, the dimensions of the point on it, and the path's throughput.
+    quad: [Lanes3; 4],
+    quad_area: [f32; PACKET],
+    quad_pmf: [f32; PACKET],
+    emission: Lanes3,
+    u_light: [[f32; PACKET]; 2],
+    throughput: Lanes3,
     // Outputs.
+    lit: [bool; PACKET],
+    shadow_origin: Lanes3,
+    shadow_dir: Lanes3,
+    shadow_t_max: [f32; PACKET],
+    unblocked: Lanes3,
     wi: Lanes3,
     weight: Lanes3,
     pdf: [f32; PACKET],
@@ -65,6 +87,18 @@ impl Default for DiffuseLanes {
             color: zero,
             u: [[0.0; PACKET]; 2],
             u_rr: [0.0; PACKET],
+            quad_light: 0,
+            quad: [zero; 4],
+            quad_area: [1.0; PACKET],
+            quad_pmf: [0.0; PACKET],
+            emission: zero,
+            u_light: [[0.0; PACKET]; 2],
+            throughput: zero,
+            lit: [false; PACKET],
+            shadow_origin: zero,
+            shadow_dir: zero,
+            shadow_t_max: [0.0; PACKET],
+            unblocked: zero,
             wi: zero,
             weight: zero,
             pdf: [0.0; PACKET],
@@ -94,6 +128,13 @@ fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
 }
 
 impl DiffuseLanes {
+    /// No lane waits.
+    #[inline(always)]
+    pub fn clear(&mut self) {
+        self.mask = 0;
+        self.quad_light = 0;
+    }
+
     /// Lane `l` waits at `position`, whose Lambert lobe of colour `color` has shading normal
     /// `n` and geometric normal `ng` (both on the side of `wo`), with the dimensions of its
     /// BSDF sample (`u`) and of Russian roulette (`u_rr`).
@@ -124,9 +165,44 @@ impl DiffuseLanes {
         self.mask |= 1 << l;
     }
 
+    /// Lane `l` (also [`DiffuseLanes::push`]ed) samples quad `object` of `scene`, chosen with
+    /// probability `pmf`, at `u_light`, as `sample_area_light` would, for a path of
+    /// throughput `throughput`.
+    #[inline(always)]
+    pub fn push_quad_light(
+        &mut self,
+        l: usize,
+        scene: &CpuScene,
+        object: u32,
+        pmf: f32,
+        u_light: Vec2,
+        throughput: Vec3A,
+    ) {
+        let o = &scene.objects[object as usize];
+        let corners = [o.a, o.b, o.c].map(|v| Vec3A::from_slice(&v));
+        for (quad, v) in self.quad.iter_mut().zip(corners) {
+            set_lane(quad, l, v);
+        }
+        set_lane(&mut self.quad[3], l, scene.quad_normal(object));
+        self.quad_area[l] = scene.quad_area(object);
+        self.quad_pmf[l] = pmf;
+        set_lane(
+            &mut self.emission,
+            l,
+            Vec3A::from(scene.materials[o.material as usize].emission),
+        );
+        self.u_light[0][l] = u_light.x;
+        self.u_light[1][l] = u_light.y;
+        set_lane(&mut self.throughput, l, throughput);
+        self.quad_light |= 1 << l;
+    }
+
     /// Computes every lane side by side (those not waiting compute throw-away values).
     #[inline(always)]
     pub fn compute(&mut self) {
+        if self.quad_light != 0 {
+            self.light_quads();
+        }
         for l in 0..PACKET {
             let at = |a: &Lanes3| [a[0][l], a[1][l], a[2][l]];
             let (n, ng, wo) = (at(&self.n), at(&self.ng), at(&self.wo));
@@ -157,6 +233,63 @@ impl DiffuseLanes {
         }
     }
 
+    /// The quad lights' samples side by side: `sample_area_light` of a quad, then what
+    /// `Path::step` does with it: `eval_lobes` of the Lambert lobe alone, `power_heuristic`,
+    /// `shadow_ray`.
+    #[inline(always)]
+    fn light_quads(&mut self) {
+        for l in 0..PACKET {
+            let at = |a: &Lanes3| [a[0][l], a[1][l], a[2][l]];
+            let (p, n, ng, wo) = (at(&self.position), at(&self.n), at(&self.ng), at(&self.wo));
+            let [a, b, c, normal] = self.quad.each_ref().map(at);
+            // `sample_shape` and `sample_area_light`.
+            let (ux, uy) = (self.u_light[0][l], self.u_light[1][l]);
+            let q: [f32; 3] = std::array::from_fn(|i| a[i] + ux * b[i] + uy * c[i]);
+            let density = 1.0 / self.quad_area[l];
+            let to_light: [f32; 3] = std::array::from_fn(|i| q[i] - p[i]);
+            let distance = dot(to_light, to_light).sqrt();
+            let wi = to_light.map(|v| v / distance);
+            let cos_l = dot(normal, wi.map(|v| -v));
+            let pdf = self.quad_pmf[l] * density * distance * distance / cos_l;
+            // (A NaN distance or cosine makes `pdf` NaN.)
+            let sampled = distance > 0.0 && cos_l > 0.0 && pdf > 0.0 && pdf.is_finite();
+            // `eval_lobes` towards it.
+            let cos_o = dot(wo, n);
+            let cos_i = dot(wi, n);
+            let seen = dot(wi, ng) > 0.0 && cos_o > 0.0 && cos_i > 0.0;
+            let f: [f32; 3] = std::array::from_fn(|i| {
+                if seen {
+                    self.color[i][l] * FRAC_1_PI * cos_i
+                } else {
+                    0.0
+                }
+            });
+            let bsdf_pdf = if seen { FRAC_1_PI * cos_i } else { 0.0 };
+            self.lit[l] = sampled && f[0].max(f[1]).max(f[2]) > 0.0;
+            // `power_heuristic(pdf, bsdf_pdf)`.
+            let (a2, b2) = (pdf * pdf, bsdf_pdf * bsdf_pdf);
+            let weight = if a2 + b2 > 0.0 && a2.is_finite() {
+                a2 / (a2 + b2)
+            } else if a2.is_infinite() {
+                1.0
+            } else {
+                0.0
+            };
+            // `shadow_ray`: from the side of `ng` the light is on (a lit lane's).
+            let eps = 1e-4 * (1.0 + p[0].abs().max(p[1].abs()).max(p[2].abs()));
+            let origin: [f32; 3] = std::array::from_fn(|i| p[i] + ng[i] * eps);
+            let to_light: [f32; 3] = std::array::from_fn(|i| q[i] - origin[i]);
+            let distance = dot(to_light, to_light).sqrt();
+            self.shadow_t_max[l] = distance * (1.0 - 1e-4);
+            for i in 0..3 {
+                self.shadow_origin[i][l] = origin[i];
+                self.shadow_dir[i][l] = to_light[i] / distance;
+                let radiance = self.throughput[i][l] * f[i] * self.emission[i][l];
+                self.unblocked[i][l] = radiance * weight / pdf;
+            }
+        }
+    }
+
     /// Lane `l`'s results, once [`DiffuseLanes::compute`] ran.
     #[inline(always)]
     pub fn vertex(&self, l: usize) -> DiffuseVertex {
@@ -172,7 +305,13 @@ impl DiffuseLanes {
         } else {
             INVALID
         };
+        let shadow = (self.quad_light >> l & 1 != 0 && self.lit[l]).then(|| ShadowTest {
+            ray: Ray::new(lane(&self.shadow_origin, l), lane(&self.shadow_dir, l)),
+            t_max: self.shadow_t_max[l],
+            radiance: lane(&self.unblocked, l),
+        });
         DiffuseVertex {
+            shadow,
             sample,
             position: lane(&self.position, l),
             ng: lane(&self.ng, l),
@@ -186,9 +325,14 @@ impl DiffuseLanes {
 mod tests {
     use glam::{Vec2, Vec4};
 
+    use pathlight_core::gpu_types::{GpuRenderParams, KIND_QUAD, LIGHT_AREA};
+
     use super::*;
-    use crate::lobes::{LobesParams, sample_lobes};
+    use crate::integrator::shadow_ray;
+    use crate::lights::{choose_light, light_radiance, sample_table_light};
+    use crate::lobes::{LobesParams, eval_lobes, sample_lobes};
     use crate::material::MODEL_PARAMS;
+    use crate::sampling::power_heuristic;
     use crate::surface::Surface;
 
     /// A unit vector from three uniform numbers in [-1, 1) (not uniform on the sphere).
@@ -269,5 +413,95 @@ mod tests {
         }
         // Both outcomes were met often.
         assert!(checked.iter().all(|&n| n > 200), "{checked:?}");
+    }
+
+    /// Every lane's quad-light sample gives `Path::step`'s shadow test bit for bit
+    /// (`sample_area_light`, `eval_lobes`, `power_heuristic`, `shadow_ray`, the radiance it
+    /// adds), on cornell-materials' ceiling light from random points, normals and views: lit
+    /// lanes, and unlit ones (the light behind the surface, the surface seen from behind). It
+    /// fails with any operation reordered.
+    #[test]
+    fn quad_lights_as_path_step_bit_for_bit() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../scenes/refs/cornell-materials.toml"
+        );
+        let scene = pathlight_scene::load_scene_file(std::path::Path::new(path)).unwrap();
+        let prepared = pathlight_core::PreparedScene::new(&scene).unwrap();
+        let cpu_scene = CpuScene::new(&prepared);
+        let params = GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
+        let m = LobesParams::decode(&[Vec4::ZERO; MODEL_PARAMS]);
+        let mut state = 0x1234_5679_u32;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state as f32 / 4_294_967_296.0
+        };
+        let (mut lit, mut unlit) = (0, 0);
+        for _ in 0..64 {
+            let mut lanes = DiffuseLanes::default();
+            let mut cases = Vec::new();
+            for l in 0..PACKET {
+                // Draw until the light table's choice is a quad (the ceiling light).
+                let (light, pmf) = loop {
+                    let choice = choose_light(&cpu_scene, &params, next());
+                    if let Some((light, pmf, _)) = choice
+                        && light.kind == LIGHT_AREA
+                        && cpu_scene.objects[light.index as usize].kind == KIND_QUAD
+                    {
+                        break (light, pmf);
+                    }
+                };
+                let ng = unit(r3(&mut next));
+                let ns = unit(r3(&mut next) * 0.3 + ng);
+                let ns = if ns.dot(ng) < 0.0 { -ns } else { ns };
+                let wo = unit(r3(&mut next));
+                let s = Surface {
+                    position: r3(&mut next) * 0.9,
+                    ng,
+                    ns,
+                    nc: ns,
+                    uv: Vec2::ZERO,
+                    material: 0,
+                    color: Vec3A::ONE,
+                };
+                let color = Vec3A::new(next(), next(), next());
+                let throughput = Vec3A::new(next(), next(), next()) * 3.0;
+                let u_light = Vec2::new(next(), next());
+                let side = if wo.dot(ng) >= 0.0 { 1.0 } else { -1.0 };
+                lanes.push(l, s.position, ns * side, ng * side, wo, color, u_light, 0.5);
+                lanes.push_quad_light(l, &cpu_scene, light.index, pmf, u_light, throughput);
+                // What `Path::step` does with it.
+                let ls = sample_table_light(&cpu_scene, light, pmf, s.position, u_light, 0.5);
+                let e = eval_lobes(&m, color, &s, wo, ls.wi);
+                cases.push((ls.valid && e.f.max_element() > 0.0).then(|| {
+                    let (ray, t_max) = shadow_ray(s.position, s.ng, &ls);
+                    let weight = power_heuristic(ls.pdf, e.pdf);
+                    let radiance = light_radiance(&cpu_scene, &params, &ls);
+                    (ray, t_max, throughput * e.f * radiance * weight / ls.pdf)
+                }));
+            }
+            lanes.compute();
+            for (l, theirs) in cases.into_iter().enumerate() {
+                let ours = lanes.vertex(l).shadow;
+                assert_eq!(ours.is_some(), theirs.is_some(), "lane {l}");
+                let (Some(ours), Some((ray, t_max, radiance))) = (ours, theirs) else {
+                    unlit += 1;
+                    continue;
+                };
+                lit += 1;
+                let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
+                assert_eq!(
+                    bits(ours.ray.origin.into()),
+                    bits(ray.origin.into()),
+                    "lane {l}"
+                );
+                assert_eq!(bits(ours.ray.dir.into()), bits(ray.dir.into()), "lane {l}");
+                assert_eq!(ours.t_max.to_bits(), t_max.to_bits(), "lane {l}");
+                assert_eq!(bits(ours.radiance), bits(radiance), "lane {l}");
+            }
+        }
+        assert!(lit > 200 && unlit > 200, "lit {lit}, unlit {unlit}");
     }
 }

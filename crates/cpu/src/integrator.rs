@@ -2,7 +2,9 @@
 //! `integrator.wgsl` (same loop, same order of sample dimensions).
 
 use glam::Vec3A;
-use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams, NO_LIGHT};
+use pathlight_core::gpu_types::{
+    GpuAccumPixel, GpuAovPixel, GpuRenderParams, KIND_QUAD, LIGHT_AREA, NO_LIGHT,
+};
 
 use crate::bvh::Hit;
 use crate::camera::camera_ray;
@@ -11,7 +13,7 @@ use crate::diffuse::DiffuseLanes;
 use crate::environment::env_escape;
 use crate::intersect::Ray;
 use crate::light_sample::LightSample;
-use crate::lights::{light_pdf, light_radiance, sample_light};
+use crate::lights::{choose_light, light_pdf, light_radiance, sample_light, sample_table_light};
 use crate::material::{
     eval_material, has_continuous_material_lobe, is_lambert, material_absorption, material_albedo,
     material_at, sample_material,
@@ -40,7 +42,7 @@ fn offset_origin(p: Vec3A, ng: Vec3A, dir: Vec3A) -> Vec3A {
 /// light point itself, stopping just short of it, so the light never shadows itself. Twin of
 /// WGSL `shadow_ray`.
 #[inline(always)]
-fn shadow_ray(p: Vec3A, ng: Vec3A, ls: &LightSample) -> (Ray, f32) {
+pub(crate) fn shadow_ray(p: Vec3A, ng: Vec3A, ls: &LightSample) -> (Ray, f32) {
     let origin = offset_origin(p, ng, ls.wi);
     if !ls.finite {
         return (Ray::new(origin, ls.wi), T_MAX);
@@ -235,30 +237,46 @@ impl Path {
         let (u_light_select, u_lobe, u_fresnel, u_rr) =
             (u_light_select.x, u_lobe.x, u_fresnel.x, u_rr.x);
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
+        let lambert = is_lambert(material);
         let mut shadow = None;
         if continuous {
-            let ls = sample_light(scene, params, s.position, n, u_light_select, u_light);
-            if ls.valid {
-                let e = eval_material(material, &s, wo, ls.wi);
-                if e.f.max_element() > 0.0 {
-                    let (ray, t_max) = shadow_ray(s.position, s.ng, &ls);
-                    let weight = if ls.mis {
-                        power_heuristic(ls.pdf, e.pdf)
-                    } else {
-                        1.0
-                    };
-                    self.sample.rays += 1;
-                    let radiance = light_radiance(scene, params, &ls);
-                    let radiance = self.throughput * e.f * radiance * weight / ls.pdf;
-                    shadow = Some(ShadowTest {
-                        ray,
-                        t_max,
-                        radiance,
-                    });
+            let choice = choose_light(scene, params, u_light_select);
+            let quad = choice.filter(|(light, _, _)| {
+                lambert
+                    && light.kind == LIGHT_AREA
+                    && scene.objects[light.index as usize].kind == KIND_QUAD
+            });
+            if let Some((light, pmf, _)) = quad {
+                diffuse.push_quad_light(lane, scene, light.index, pmf, u_light, self.throughput);
+            } else {
+                let ls = match choice {
+                    Some((light, pmf, u_part)) => {
+                        sample_table_light(scene, light, pmf, s.position, u_light, u_part)
+                    }
+                    None => sample_light(scene, params, s.position, n, u_light_select, u_light),
+                };
+                if ls.valid {
+                    let e = eval_material(material, &s, wo, ls.wi);
+                    if e.f.max_element() > 0.0 {
+                        self.sample.rays += 1;
+                        let (ray, t_max) = shadow_ray(s.position, s.ng, &ls);
+                        let weight = if ls.mis {
+                            power_heuristic(ls.pdf, e.pdf)
+                        } else {
+                            1.0
+                        };
+                        let radiance = light_radiance(scene, params, &ls);
+                        let radiance = self.throughput * e.f * radiance * weight / ls.pdf;
+                        shadow = Some(ShadowTest {
+                            ray,
+                            t_max,
+                            radiance,
+                        });
+                    }
                 }
             }
         }
-        if is_lambert(material) {
+        if lambert {
             let ng = if wo.dot(s.ng) >= 0.0 { s.ng } else { -s.ng };
             let color = material.base_color;
             diffuse.push(lane, s.position, n, ng, wo, color, u_bsdf, u_rr);
@@ -270,11 +288,21 @@ impl Path {
     }
 
     /// Goes on from the diffuse vertex that lane `lane` of `diffuse` holds, once
-    /// [`DiffuseLanes::compute`] ran.
+    /// [`DiffuseLanes::compute`] ran: returns the shadow test of a quad light's sample left
+    /// to it, as [`Path::step`] returns its own.
     #[inline(always)]
-    pub fn leave_diffuse(&mut self, params: &GpuRenderParams, diffuse: &DiffuseLanes, lane: usize) {
+    pub fn leave_diffuse(
+        &mut self,
+        params: &GpuRenderParams,
+        diffuse: &DiffuseLanes,
+        lane: usize,
+    ) -> Option<ShadowTest> {
         let v = diffuse.vertex(lane);
+        if v.shadow.is_some() {
+            self.sample.rays += 1;
+        }
         self.bounce(params, &v.sample, v.position, v.ng, v.n, v.u_rr);
+        v.shadow
     }
 
     /// Goes on along BSDF sample `bs`, drawn at `position` (geometric normal `ng`, shading
@@ -350,11 +378,11 @@ pub fn trace_path(
     let mut diffuse = DiffuseLanes::default();
     while path.alive {
         let hit = tracer.intersect(&path.ray, T_MAX);
-        diffuse.mask = 0;
-        let shadow = path.step(scene, params, hit, &mut diffuse, 0);
+        diffuse.clear();
+        let mut shadow = path.step(scene, params, hit, &mut diffuse, 0);
         if diffuse.mask != 0 {
             diffuse.compute();
-            path.leave_diffuse(params, &diffuse, 0);
+            shadow = shadow.or(path.leave_diffuse(params, &diffuse, 0));
         }
         if let Some(shadow) = shadow
             && !tracer.occluded(&shadow.ray, shadow.t_max)

@@ -6,7 +6,7 @@
 //! by a ray, so only they have a density for [`light_pdf`]. Twin of `lights.wgsl`.
 
 use glam::{Vec2, Vec3A};
-use pathlight_core::gpu_types::{GpuRenderParams, KIND_MESH, LIGHT_POINT, LIGHT_SUN};
+use pathlight_core::gpu_types::{GpuLight, GpuRenderParams, KIND_MESH, LIGHT_POINT, LIGHT_SUN};
 
 use crate::area_light::{area_light_pdf, sample_area_light};
 use crate::cpu_scene::CpuScene;
@@ -40,8 +40,35 @@ pub fn light_pdf(
     area_light_pdf(scene, o, object, primitive, pmf, p, p_light, n_light)
 }
 
+/// A light of the table chosen with `u_select` (the environment's share, `env_pmf`, below):
+/// its entry, the probability of choosing it (the environment's share included), and the
+/// part of `u_select` inside its entry, for the light's own choices. `None` where
+/// `u_select` chooses the environment or the table is empty.
+#[inline(always)]
+pub fn choose_light(
+    scene: &CpuScene,
+    params: &GpuRenderParams,
+    u_select: f32,
+) -> Option<(GpuLight, f32, f32)> {
+    if u_select < params.env_pmf || params.light_count == 0 {
+        return None;
+    }
+    let u_light = ((u_select - params.env_pmf) / (1.0 - params.env_pmf)).min(0.999_999_94);
+    // First entry whose cumulative probability exceeds u_light.
+    let entry = first_above(params.light_count, u_light, |i| {
+        scene.lights[i as usize].cdf
+    });
+    let light = scene.lights[entry as usize];
+    // The part of u_light inside the chosen entry, for the light's own choices.
+    let below = light.cdf - light.pmf;
+    let u_part = ((u_light - below) / light.pmf.max(1e-30)).clamp(0.0, 1.0);
+    let pmf = light.pmf * (1.0 - params.env_pmf);
+    Some((light, pmf, u_part))
+}
+
 /// A light and a point on it as seen from `p` with normal `n` (on the side light is
-/// gathered from): `u_select` chooses the light, `u` the point. Twin of WGSL `sample_light`.
+/// gathered from): `u_select` chooses the light ([`choose_light`]), `u` the point. Twin of
+/// WGSL `sample_light`.
 #[inline(always)]
 pub fn sample_light(
     scene: &CpuScene,
@@ -54,19 +81,23 @@ pub fn sample_light(
     if u_select < params.env_pmf {
         return sample_environment(scene, params, n, u);
     }
-    if params.light_count == 0 {
-        return INVALID;
+    match choose_light(scene, params, u_select) {
+        Some((light, pmf, u_part)) => sample_table_light(scene, light, pmf, p, u, u_part),
+        None => INVALID,
     }
-    let u_light = ((u_select - params.env_pmf) / (1.0 - params.env_pmf)).min(0.999_999_94);
-    // First entry whose cumulative probability exceeds u_light.
-    let entry = first_above(params.light_count, u_light, |i| {
-        scene.lights[i as usize].cdf
-    });
-    let light = scene.lights[entry as usize];
-    // The part of u_light inside the chosen entry, for the light's own choices.
-    let below = light.cdf - light.pmf;
-    let u_part = ((u_light - below) / light.pmf.max(1e-30)).clamp(0.0, 1.0);
-    let pmf = light.pmf * (1.0 - params.env_pmf);
+}
+
+/// A point on `light` (chosen with probability `pmf`) as seen from `p`, by its type's
+/// module.
+#[inline(always)]
+pub fn sample_table_light(
+    scene: &CpuScene,
+    light: GpuLight,
+    pmf: f32,
+    p: Vec3A,
+    u: Vec2,
+    u_part: f32,
+) -> LightSample {
     match light.kind {
         LIGHT_POINT => sample_point_light(scene, light.index, pmf, p, u),
         LIGHT_SUN => sample_sun_light(scene, light.index, pmf, u),

@@ -89,7 +89,7 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
         let hits = tracer.intersect_packet(&packet);
         shadows.active = 0;
         let mut unblocked = [Vec3A::ZERO; PACKET];
-        diffuse.mask = 0;
+        diffuse.clear();
         for (l, lane) in lanes.iter_mut().enumerate() {
             if let Some((_, path)) = lane
                 && let Some(shadow) = path.step(scene, params, hits.hit(l), &mut diffuse, l)
@@ -106,8 +106,13 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
             while left != 0 {
                 let l = left.trailing_zeros() as usize;
                 left &= left - 1;
-                if let Some((_, path)) = &mut lanes[l] {
-                    path.leave_diffuse(params, &diffuse, l);
+                if let Some((_, path)) = &mut lanes[l]
+                    && let Some(shadow) = path.leave_diffuse(params, &diffuse, l)
+                {
+                    shadows.rays[l] = shadow.ray;
+                    shadows.t_max[l] = shadow.t_max;
+                    shadows.active |= 1 << l;
+                    unblocked[l] = shadow.radiance;
                 }
             }
         }
