@@ -10,7 +10,7 @@ use crate::bvh::Hit;
 use crate::camera::camera_ray;
 use crate::cpu_scene::CpuScene;
 use crate::diffuse::DiffuseLanes;
-use crate::environment::env_escape;
+use crate::environment::{env_escape, has_env_map};
 use crate::intersect::Ray;
 use crate::light_sample::LightSample;
 use crate::lights::{choose_light, light_pdf, light_radiance, sample_light, sample_table_light};
@@ -246,8 +246,12 @@ impl Path {
                     && light.kind == LIGHT_AREA
                     && scene.objects[light.index as usize].kind == KIND_QUAD
             });
+            let sky = lambert && u_light_select < params.env_pmf && !has_env_map(params);
             if let Some((light, pmf, _)) = quad {
                 diffuse.push_quad_light(lane, scene, light.index, pmf, u_light, self.throughput);
+            } else if sky {
+                let radiance = Vec3A::from(params.environment);
+                diffuse.push_sky_light(lane, radiance, params.env_pmf, u_light, self.throughput);
             } else {
                 let ls = match choice {
                     Some((light, pmf, u_part)) => {
