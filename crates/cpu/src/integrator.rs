@@ -183,6 +183,7 @@ impl Path {
             self.alive = false;
             return None;
         };
+        self.sampler.prepare();
         let s = surface_at(scene, &hit, &ray);
         let material = &material_at(scene, &s);
         let wo = -Vec3A::from(ray.dir);

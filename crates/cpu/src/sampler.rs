@@ -95,11 +95,15 @@ pub struct Sampler {
     dimension: u32,
     rng_state: u32,
     /// Sobol: the values of the [`LANES`] dimensions from `ahead_from` (both coordinates),
-    /// the window [`Sampler::next_batch`] serves from, computed ahead of their use so that
-    /// their hash chains' latency overlaps the shading that comes between.
+    /// the window [`Sampler::next_batch`] serves from, computed ahead of their use
+    /// ([`Sampler::prepare`]) so that their hash chains' latency overlaps the shading that
+    /// comes between.
     ahead: [Vec2; LANES],
     /// The first dimension in `ahead`; `u32::MAX` before the first batch.
     ahead_from: u32,
+    /// The window from `ahead_from` is due: not computed yet ([`Sampler::prepare`] or the
+    /// next request computes it).
+    due: bool,
 }
 
 impl Sampler {
@@ -124,6 +128,18 @@ impl Sampler {
             },
             ahead: [Vec2::ZERO; LANES],
             ahead_from: u32::MAX,
+            due: false,
+        }
+    }
+
+    /// Computes the window the next bounce will draw from, if due: called where the path
+    /// is known to go on (a hit), ahead of the draw, so that the window's hash chains overlap
+    /// the shading before it, and no window is computed for a path that ends.
+    #[inline(always)]
+    pub fn prepare(&mut self) {
+        if self.due {
+            self.ahead = self.sobol_lanes(self.ahead_from);
+            self.due = false;
         }
     }
 
@@ -158,8 +174,9 @@ impl Sampler {
     /// [`LANES`] at a time side by side in SIMD lanes, into a window of values that serves
     /// the requests in turn: the camera's one or two dimensions and the first bounce's six
     /// come from one window. When what is left of the window cannot serve a bounce, the next
-    /// window is computed at once, ahead of its use, so that its latency overlaps the
-    /// shading in between. The WGSL draws them one by one.
+    /// window is due: [`Sampler::prepare`] computes it ahead of its use once the path is
+    /// known to go on (else this does when asked), so that its latency overlaps the shading
+    /// in between and a path that ends computes none. The WGSL draws them one by one.
     #[inline(always)]
     pub fn next_batch<const N: usize>(&mut self, draws: [Draw; N]) -> [Vec2; N] {
         const { assert!(N <= LANES) };
@@ -175,6 +192,7 @@ impl Sampler {
             }
             return out;
         }
+        self.prepare();
         let mut offset = self.dimension.wrapping_sub(self.ahead_from) as usize;
         if self.ahead_from == u32::MAX || offset + N > LANES {
             // Not in the window (the first request, or a larger batch than a bounce's).
@@ -190,8 +208,8 @@ impl Sampler {
         }
         self.dimension += N as u32;
         if offset + N + BOUNCE_DIMENSIONS > LANES {
-            self.ahead = self.sobol_lanes(self.dimension);
             self.ahead_from = self.dimension;
+            self.due = true;
         }
         out
     }
