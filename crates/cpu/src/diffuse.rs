@@ -537,11 +537,13 @@ mod tests {
         assert!(checked.iter().all(|&n| n > 200), "{checked:?}");
     }
 
-    /// Which light [`light_lanes_as_path_step`] samples.
+    /// Which lights [`light_lanes_as_path_step`] samples.
     #[derive(Clone, Copy, PartialEq)]
     enum Light {
         Quad,
         Sky,
+        /// Quads and a constant sky in one packet: each kind's results stay in its lanes.
+        Both,
     }
 
     /// Every lane's light sample of kind `kind` in the reference scene `name` gives
@@ -558,9 +560,11 @@ mod tests {
         let prepared = pathlight_core::PreparedScene::new(&scene).unwrap();
         let cpu_scene = CpuScene::new(&prepared);
         let mut params = GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
-        if kind == Light::Sky {
-            // A share of the light samples other than 1, so that its arithmetic shows.
+        if kind != Light::Quad {
+            // A share of the light samples other than 1, so that its arithmetic shows, and a
+            // sky of some colour.
             params.env_pmf = 0.37;
+            params.environment = [0.3, 0.5, 0.7];
         }
         let m = LobesParams::decode(&[Vec4::ZERO; MODEL_PARAMS]);
         let mut state = 0x1234_5679_u32;
@@ -580,11 +584,11 @@ mod tests {
                     let u_select = next();
                     let choice = choose_light(&cpu_scene, &params, u_select);
                     let wanted = match (kind, choice) {
-                        (Light::Quad, Some((light, _, _))) => {
+                        (Light::Quad | Light::Both, Some((light, _, _))) => {
                             light.kind == LIGHT_AREA
                                 && cpu_scene.objects[light.index as usize].kind == KIND_QUAD
                         }
-                        (Light::Sky, None) => u_select < params.env_pmf,
+                        (Light::Sky | Light::Both, None) => u_select < params.env_pmf,
                         _ => false,
                     };
                     if wanted {
@@ -663,5 +667,12 @@ mod tests {
     #[test]
     fn sky_lights_as_path_step_bit_for_bit() {
         light_lanes_as_path_step("furnace-0.8", Light::Sky);
+    }
+
+    /// Both in one packet (the sky's results written only to its own lanes). Fails with
+    /// them written to every lane.
+    #[test]
+    fn quad_and_sky_lights_as_path_step_bit_for_bit() {
+        light_lanes_as_path_step("cornell-materials", Light::Both);
     }
 }
