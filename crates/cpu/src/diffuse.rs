@@ -462,6 +462,29 @@ mod tests {
         v.into().normalize()
     }
 
+    /// Uniform numbers in [0, 1) (xorshift from `seed`).
+    fn uniform(mut state: u32) -> impl FnMut() -> f32 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state as f32 / 4_294_967_296.0
+        }
+    }
+
+    /// The surface at `position` with geometric normal `ng` and shading normal `ns`.
+    fn surface(position: Vec3A, ng: Vec3A, ns: Vec3A) -> Surface {
+        Surface {
+            position,
+            ng,
+            ns,
+            nc: ns,
+            uv: Vec2::ZERO,
+            material: 0,
+            color: Vec3A::ONE,
+        }
+    }
+
     /// Three uniform numbers in [-1, 1) drawn from `next`.
     fn r3(next: &mut impl FnMut() -> f32) -> Vec3A {
         Vec3A::new(next(), next(), next()) * 2.0 - 1.0
@@ -478,13 +501,7 @@ mod tests {
         block[1].y = 1.5;
         let m = LobesParams::decode(&block);
         assert!(m.is_lambert());
-        let mut state = 0x9e37_79b9_u32;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state as f32 / 4_294_967_296.0
-        };
+        let mut next = uniform(0x9e37_79b9);
         let mut checked = [0; 2];
         for round in 0..64 {
             let mut lanes = DiffuseLanes::default();
@@ -504,15 +521,7 @@ mod tests {
                     u = Vec2::new([0.0, 1.0f32.next_down()][l % 2], [0.0, 0.999_999_9][l / 16]);
                 }
                 let color = Vec3A::new(next(), next(), next());
-                let s = Surface {
-                    position: r3(&mut next) * 10.0,
-                    ng,
-                    ns,
-                    nc: ns,
-                    uv: Vec2::ZERO,
-                    material: 0,
-                    color: Vec3A::ONE,
-                };
+                let s = surface(r3(&mut next) * 10.0, ng, ns);
                 let side = if wo.dot(ng) >= 0.0 { 1.0 } else { -1.0 };
                 let (n, ng_side) = (ns * side, ng * side);
                 lanes.push(l, s.position, n, ng_side, wo, color, u, 0.5);
@@ -567,13 +576,7 @@ mod tests {
             params.environment = [0.3, 0.5, 0.7];
         }
         let m = LobesParams::decode(&[Vec4::ZERO; MODEL_PARAMS]);
-        let mut state = 0x1234_5679_u32;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state as f32 / 4_294_967_296.0
-        };
+        let mut next = uniform(0x1234_5679);
         let (mut lit, mut unlit) = (0, 0);
         for _ in 0..64 {
             let mut lanes = DiffuseLanes::default();
@@ -599,15 +602,7 @@ mod tests {
                 let ns = unit(r3(&mut next) * 0.3 + ng);
                 let ns = if ns.dot(ng) < 0.0 { -ns } else { ns };
                 let wo = unit(r3(&mut next));
-                let s = Surface {
-                    position: r3(&mut next) * 0.9,
-                    ng,
-                    ns,
-                    nc: ns,
-                    uv: Vec2::ZERO,
-                    material: 0,
-                    color: Vec3A::ONE,
-                };
+                let s = surface(r3(&mut next) * 0.9, ng, ns);
                 let color = Vec3A::new(next(), next(), next());
                 let throughput = Vec3A::new(next(), next(), next()) * 3.0;
                 let u_light = Vec2::new(next(), next());
