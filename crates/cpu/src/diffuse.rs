@@ -26,8 +26,9 @@ type Lanes3 = [[f32; PACKET]; 3];
 /// A diffuse vertex with its BSDF sample, and what the path needs to go on from it.
 #[derive(Debug, Clone, Copy)]
 pub struct DiffuseVertex {
-    /// The shadow test of its quad light's sample ([`DiffuseLanes::push_quad_light`]), unless
-    /// the BSDF passes nothing of it on.
+    /// The shadow test of its light sample where the lanes took it
+    /// ([`DiffuseLanes::push_quad_light`], [`DiffuseLanes::push_sky_light`]), unless the BSDF
+    /// passes nothing of it on.
     pub shadow: Option<ShadowTest>,
     /// The BSDF sample.
     pub sample: BsdfSample,
@@ -42,7 +43,7 @@ pub struct DiffuseVertex {
 }
 
 /// Per lane, a diffuse vertex waiting for the rest of its bounce ([`DiffuseLanes::push`]),
-/// and after [`DiffuseLanes::compute`] its sample ([`DiffuseLanes::vertex`]).
+/// and after [`DiffuseLanes::compute`] its results ([`DiffuseLanes::vertex`]).
 #[derive(Debug, Clone)]
 pub struct DiffuseLanes {
     /// Bit `l` set: lane `l` waits (or, after `compute`, has its results).
@@ -59,11 +60,11 @@ pub struct DiffuseLanes {
     u_rr: [f32; PACKET],
     /// Bit `l` set: lane `l`'s light sample is of a constant environment instead
     /// ([`DiffuseLanes::push_sky_light`]), of probability `sky_pmf`.
-    pub sky_light: Lanes,
+    sky_light: Lanes,
     sky_pmf: f32,
     /// Bit `l` set: lane `l`'s light sample is on a quad light, and waits too
     /// ([`DiffuseLanes::push_quad_light`]).
-    pub quad_light: Lanes,
+    quad_light: Lanes,
     /// The quad (corner, edges, unit normal, area), the probability of having chosen it, its
     /// radiance, the dimensions of the point on it, and the path's throughput.
     quad: [Lanes3; 4],
