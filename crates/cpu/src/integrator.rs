@@ -148,8 +148,9 @@ impl Path {
     /// Goes on from `hit`, the nearest hit of [`Path::ray`]: adds what the path sees there,
     /// samples a light (returning its shadow ray, for the caller to trace and
     /// [`Path::add_unblocked`]) and the BSDF (the next ray), or ends the path. On a purely
-    /// diffuse surface the BSDF sample is left to `diffuse` as lane `lane`: once
-    /// [`DiffuseLanes::sample`] ran, [`Path::leave_diffuse`] goes on.
+    /// diffuse surface the rest of the bounce (the BSDF sample, and the light sample of a quad
+    /// or a constant sky) is left to `diffuse` as lane `lane`: once
+    /// [`DiffuseLanes::compute`] ran, [`Path::leave_diffuse`] goes on.
     #[inline(always)]
     pub fn step(
         &mut self,
@@ -293,8 +294,8 @@ impl Path {
     }
 
     /// Goes on from the diffuse vertex that lane `lane` of `diffuse` holds, once
-    /// [`DiffuseLanes::compute`] ran: returns the shadow test of a quad light's sample left
-    /// to it, as [`Path::step`] returns its own.
+    /// [`DiffuseLanes::compute`] ran: returns the shadow test of the light sample left to it,
+    /// as [`Path::step`] returns its own.
     #[inline(always)]
     pub fn leave_diffuse(
         &mut self,

@@ -171,7 +171,7 @@ impl Sampler {
     /// Owen-scrambled shuffled index (dimension 0, the van der Corput sequence, is the index
     /// reversed; dimension 1 is `sobol_1_reversed` of it), each scramble seeded by hashing
     /// the pixel and dimension. The dimensions' hash chains are independent, so they run
-    /// [`LANES`] at a time side by side in SIMD lanes, into a window of values that serves
+    /// `LANES` (eight) at a time side by side in SIMD lanes, into a window of values that serves
     /// the requests in turn: the camera's one or two dimensions and the first bounce's six
     /// come from one window. When what is left of the window cannot serve a bounce, the next
     /// window is due: [`Sampler::prepare`] computes it ahead of its use once the path is
