@@ -6,7 +6,11 @@
 //! compiler turns into SIMD instructions, they take the place of long chains of scalar
 //! square roots and divisions per path. The values are the one-path functions' bit for bit
 //! (`sample_lobes`, `sample_area_light`, `sample_environment`, `eval_lobes`,
-//! `power_heuristic`, `shadow_ray`): the same operations in the same order. CPU only (on
+//! `power_heuristic`, `shadow_ray`): the same operations in the same order. Scalar helpers
+//! are called as they are (`sin_cos_turns`, `power_heuristic`); those written on glam's
+//! `Vec3A` (`Frame`, `sample_cosine_hemisphere`, the dot product) are written again here on
+//! `[f32; 3]`, as the packet code keeps its lanes in plain arrays (`Vec3A` is one SSE
+//! register per vector), and the tests below hold each copy to its original. CPU only (on
 //! the GPU, threads are lanes already).
 
 use std::f32::consts::{FRAC_1_PI, PI};
@@ -18,7 +22,7 @@ use crate::integrator::{ShadowTest, T_MAX};
 use crate::intersect::Ray;
 use crate::microfacet::{BsdfSample, INVALID};
 use crate::packet::{Lanes, PACKET};
-use crate::sampling::sin_cos_turns;
+use crate::sampling::{power_heuristic, sin_cos_turns};
 
 /// A vector per lane, stored per axis.
 type Lanes3 = [[f32; PACKET]; 3];
@@ -371,15 +375,7 @@ impl DiffuseLanes {
         });
         let bsdf_pdf = if seen { FRAC_1_PI * cos_i } else { 0.0 };
         let lit = sampled && f[0].max(f[1]).max(f[2]) > 0.0;
-        // `power_heuristic(pdf, bsdf_pdf)`.
-        let (a2, b2) = (pdf * pdf, bsdf_pdf * bsdf_pdf);
-        let weight = if a2 + b2 > 0.0 && a2.is_finite() {
-            a2 / (a2 + b2)
-        } else if a2.is_infinite() {
-            1.0
-        } else {
-            0.0
-        };
+        let weight = power_heuristic(pdf, bsdf_pdf);
         let eps = 1e-4 * (1.0 + p[0].abs().max(p[1].abs()).max(p[2].abs()));
         let origin = std::array::from_fn(|i| p[i] + ng[i] * eps);
         let unblocked =
@@ -455,7 +451,6 @@ mod tests {
     use crate::lights::{choose_light, light_radiance, sample_light, sample_table_light};
     use crate::lobes::{LobesParams, eval_lobes, sample_lobes};
     use crate::material::MODEL_PARAMS;
-    use crate::sampling::power_heuristic;
     use crate::surface::Surface;
 
     /// A unit vector from three uniform numbers in [-1, 1) (not uniform on the sphere).

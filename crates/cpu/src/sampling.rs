@@ -186,6 +186,7 @@ pub fn sample_disk(u: Vec2) -> Vec2 {
 
 /// Power heuristic (beta = 2) weight of a strategy with density `a` against one with `b`.
 /// Twin of WGSL `power_heuristic`.
+#[inline(always)]
 pub fn power_heuristic(a: f32, b: f32) -> f32 {
     let a2 = a * a;
     let b2 = b * b;
