@@ -75,8 +75,8 @@ pub fn fresnel_conductor(cos_i: f32, eta: Vec3A, k: Vec3A) -> Vec3A {
     let eta2 = eta * eta;
     let k2 = k * k;
     let t0 = eta2 - k2 - sin2;
-    let a2pb2 = (t0 * t0 + 4.0 * eta2 * k2).max(Vec3A::ZERO).map(f32::sqrt);
-    let a = (0.5 * (a2pb2 + t0)).max(Vec3A::ZERO).map(f32::sqrt);
+    let a2pb2 = sqrt3((t0 * t0 + 4.0 * eta2 * k2).max(Vec3A::ZERO));
+    let a = sqrt3((0.5 * (a2pb2 + t0)).max(Vec3A::ZERO));
     let t1 = a2pb2 + cos2;
     let t2 = 2.0 * cos_i * a;
     let rs = (t1 - t2) / (t1 + t2).max(Vec3A::splat(1e-20));
@@ -84,6 +84,18 @@ pub fn fresnel_conductor(cos_i: f32, eta: Vec3A, k: Vec3A) -> Vec3A {
     let t4 = t2 * sin2;
     let rp = rs * (t3 - t4) / (t3 + t4).max(Vec3A::splat(1e-20));
     0.5 * (rp + rs)
+}
+
+/// The square root of each component of `v`, in one instruction where the vector is a SIMD
+/// register (glam's `Vec3A::sqrt` takes three; the roots are the same, each correctly
+/// rounded).
+#[inline(always)]
+fn sqrt3(v: Vec3A) -> Vec3A {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: SSE is part of x86-64's baseline.
+    return Vec3A::from(unsafe { std::arch::x86_64::_mm_sqrt_ps(v.into()) });
+    #[cfg(not(target_arch = "x86_64"))]
+    v.map(f32::sqrt)
 }
 
 /// GGX normal distribution, local `m`. Twin of WGSL `ggx_d`.
