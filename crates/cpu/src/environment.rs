@@ -59,7 +59,11 @@ pub struct MapCell {
 fn map_cell(params: &GpuRenderParams, uv: Vec2) -> MapCell {
     let (w, h) = (params.env_width, params.env_height);
     let mut x = uv.x * w as f32 - 0.5;
-    x -= (x / w as f32).floor() * w as f32;
+    // Wrapped into [0, w): x starts in [-0.5, w - 0.5] (u in [0, 1]), so this is WGSL's
+    // `x - floor(x / w) * w` bit for bit, without its division.
+    if x < 0.0 {
+        x += w as f32;
+    }
     let y = uv.y * (h - 1) as f32;
     let column = (x as u32).min(w - 1);
     let row = (y as u32).min(h - 2);
@@ -430,6 +434,26 @@ mod tests {
             .map(|&(r, c)| counts[(r * w + c) as usize])
             .sum();
         assert!(f64::from(sun) > 0.5 * total, "{sun} of {total}");
+    }
+
+    #[test]
+    fn the_cell_wraps_as_wgsl_wraps_it() {
+        // WGSL's `x - floor(x / w) * w`, bit for bit, at the ends of [0, 1] and between.
+        let (_, params) = sun_map(0.0);
+        let w = params.env_width as f32;
+        let mut us = vec![0.0, 1.0, 1.0f32.next_down(), 1e-9, 0.5 / w, 0.5 / w - 1e-7];
+        us.extend((0..10_000).map(|i| i as f32 / 9_999.0));
+        for u in us {
+            let c = map_cell(&params, Vec2::new(u, 0.3));
+            let mut x = u * w - 0.5;
+            x -= (x / w).floor() * w;
+            let column = (x as u32).min(params.env_width - 1);
+            assert_eq!(
+                (c.column, c.f.x.to_bits()),
+                (column, (x - column as f32).to_bits()),
+                "u {u}"
+            );
+        }
     }
 
     #[test]
