@@ -351,3 +351,31 @@ pub fn continuous_sample(e: BsdfEval, s: &Surface, wo: Vec3A, wi: Vec3A, ior: f3
         valid: true,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sqrt3_is_each_components_square_root_bit_for_bit() {
+        let mut values = vec![0.0, -0.0, 1.0, 2.0, f32::MIN_POSITIVE, 1e-45, f32::MAX];
+        values.extend([f32::INFINITY, 0.1, 3.0, 1e-30, 1e30]);
+        let mut state = 0x2545_f491_u32;
+        for _ in 0..10_000 {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            values.push(f32::from_bits(state >> 1)); // every positive float, NaNs among them
+        }
+        for v in values.chunks_exact(3) {
+            let got = sqrt3(Vec3A::new(v[0], v[1], v[2])).to_array();
+            for (g, x) in got.iter().zip(v) {
+                let want = x.sqrt();
+                assert!(
+                    g.to_bits() == want.to_bits() || (g.is_nan() && want.is_nan()),
+                    "sqrt({x}) = {g}, want {want}"
+                );
+            }
+        }
+    }
+}
