@@ -403,7 +403,7 @@ pub fn lane_used(node: &GpuWideNode, lane: usize) -> bool {
     node.lo_x[lane] <= node.hi_x[lane]
 }
 
-/// Per node of `nodes` (in pre-order, as [`collapse`] lays them out), its parent's index
+/// Per node of `nodes` (in pre-order, as the build lays them out), its parent's index
 /// times 4 plus its lane there; [`NO_PARENT`] for the root. The GPU walk climbs it when its
 /// traversal stack is full (`trace_stackless` in `bvh.wgsl`).
 pub fn parents(nodes: &[GpuWideNode]) -> Vec<u32> {

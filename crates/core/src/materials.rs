@@ -30,7 +30,7 @@ pub const MODEL_PARAMS: usize = 5;
 pub const MODEL_PARAMS_SHORT: usize = 4;
 
 /// Where the parameter buffer holds the sheen albedo table
-/// ([`SHEEN_ALBEDO`](crate::sheen_table::SHEEN_ALBEDO), four entries a vector), ahead of
+/// ([`crate::sheen_table::SHEEN_ALBEDO`], four entries a vector), ahead of
 /// every material's block (WGSL `SHEEN_TABLE`).
 pub const SHEEN_TABLE: u32 = 0;
 /// Vectors the sheen albedo table fills.

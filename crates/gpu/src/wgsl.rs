@@ -1,5 +1,5 @@
 //! The WGSL of the crate: every file under `shaders/` (a table `build.rs` generates from the
-//! folder), joined into modules by their imports ([`assembly`]).
+//! folder), joined into modules by their imports (the private `assembly` module).
 
 mod assembly;
 

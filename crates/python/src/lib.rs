@@ -1,6 +1,6 @@
 //! `import pathlight`: the Python module. Scenes are loaded from scene files and glTF files
-//! or built from Python data with the scene file's keys ([`scene`]), rendered progressively
-//! on either backend into NumPy arrays ([`renderer`]); state files resume and merge exactly
+//! or built from Python data with the scene file's keys (module `scene`), rendered progressively
+//! on either backend into NumPy arrays (module `renderer`); state files resume and merge exactly
 //! as the command line's do. The Python package around it (`python/pathlight`) re-exports
 //! these and carries the type stubs.
 

@@ -120,7 +120,7 @@ impl TriangleMesh {
 pub struct Object {
     /// Name from the file, or `<kind><index>` when the file gives none.
     pub name: String,
-    /// Index into [`Scene::materials`].
+    /// Index into [`crate::Scene::materials`].
     pub material: u32,
     /// Geometry.
     pub shape: Shape,

@@ -1,6 +1,6 @@
 //! Building a [`Scene`] from scene-file text: validation, name resolution, asset loading.
-//! The camera, settings and environment are read here, the materials in [`materials`], the
-//! shapes and placed glTF files in [`objects`], the lights in [`lights`].
+//! The camera, settings and environment are read here, the materials in `materials`, the
+//! shapes and placed glTF files in `objects`, the lights in `lights` (its private modules).
 
 mod lights;
 mod materials;
