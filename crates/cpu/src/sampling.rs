@@ -17,6 +17,7 @@ pub struct Frame {
 
 impl Frame {
     /// Basis around unit `n` (Duff et al., JCGT 2017). Twin of WGSL `frame_around`.
+    #[inline(always)]
     pub fn around(n: Vec3A) -> Self {
         let s = if n.z >= 0.0 { 1.0 } else { -1.0 };
         let a = -1.0 / (s + n.z);
@@ -29,11 +30,13 @@ impl Frame {
     }
 
     /// World direction of local `v`.
+    #[inline(always)]
     pub fn to_world(&self, v: Vec3A) -> Vec3A {
         self.t * v.x + self.b * v.y + self.n * v.z
     }
 
     /// Local coordinates of world `v`.
+    #[inline(always)]
     pub fn to_local(&self, v: Vec3A) -> Vec3A {
         Vec3A::new(v.dot(self.t), v.dot(self.b), v.dot(self.n))
     }

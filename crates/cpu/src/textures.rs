@@ -10,6 +10,7 @@ use pathlight_core::gpu_types::{
 use crate::cpu_scene::CpuScene;
 
 /// sRGB decoding. Twin of WGSL `srgb_to_linear`.
+#[inline(always)]
 pub fn srgb_to_linear(c: Vec3A) -> Vec3A {
     c.map(|c| {
         if c <= 0.04045 {
@@ -21,12 +22,14 @@ pub fn srgb_to_linear(c: Vec3A) -> Vec3A {
 }
 
 /// Twin of WGSL `texel`.
+#[inline(always)]
 fn texel(scene: &CpuScene, slot: &GpuTextureSlot, x: u32, y: u32) -> Vec4 {
     let packed = scene.texels[(slot.offset + y * slot.width + x) as usize];
     Vec4::from_array(packed.to_le_bytes().map(f32::from)) / 255.0
 }
 
 /// Twin of WGSL `wrap_coordinate`.
+#[inline(always)]
 fn wrap(x: f32, mode: u32) -> f32 {
     match mode {
         WRAP_CLAMP => x.clamp(0.0, 1.0),
@@ -39,6 +42,7 @@ fn wrap(x: f32, mode: u32) -> f32 {
 }
 
 /// Twin of WGSL `texel_index`.
+#[inline(always)]
 fn texel_index(i: f32, n: u32, mode: u32) -> u32 {
     if mode == WRAP_REPEAT {
         ((i + n as f32) as i32 % n as i32) as u32
@@ -49,6 +53,7 @@ fn texel_index(i: f32, n: u32, mode: u32) -> u32 {
 
 /// Bilinear RGBA lookup as stored (sRGB not decoded); row 0 is v = 0. Twin of WGSL
 /// `sample_slot`.
+#[inline(always)]
 pub fn sample_slot(scene: &CpuScene, slot: &GpuTextureSlot, uv: Vec2) -> Vec4 {
     let info = slot;
     let (mode_u, mode_v) = (slot.wrap & 3, (slot.wrap >> 2) & 3);
@@ -87,6 +92,7 @@ pub fn material_texture(scene: &CpuScene, m: &GpuMaterial, which: u32, uv: Vec2)
 }
 
 /// Texture coordinates at barycentrics (b1, b2) of `triangle`. Twin of WGSL `triangle_uv`.
+#[inline(always)]
 pub fn triangle_uv(scene: &CpuScene, triangle: u32, b1: f32, b2: f32) -> Vec2 {
     let [v0, v1, v2] = scene.corners(triangle).map(|v| Vec2::from(v.uv));
     (1.0 - b1 - b2) * v0 + b1 * v1 + b2 * v2
