@@ -392,6 +392,7 @@ fn mixture_sample(
 }
 
 /// A delta sample of weight `weight`.
+#[inline(always)]
 fn delta(wi: Vec3A, weight: Vec3A, valid: bool) -> BsdfSample {
     BsdfSample {
         wi,

@@ -162,6 +162,7 @@ pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3A {
 }
 
 /// Uniform direction on the unit sphere. Twin of WGSL `sample_uniform_sphere`.
+#[inline(always)]
 pub fn sample_uniform_sphere(u: Vec2) -> Vec3A {
     let z = 1.0 - 2.0 * u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
@@ -181,6 +182,7 @@ pub fn sample_cone(axis: Vec3A, one_minus_cos: f32, u: Vec2) -> Vec3A {
 }
 
 /// Uniform point on the unit disk (polar). Twin of WGSL `sample_disk`.
+#[inline(always)]
 pub fn sample_disk(u: Vec2) -> Vec2 {
     let r = u.x.sqrt();
     let (sin, cos) = sin_cos_turns(u.y);

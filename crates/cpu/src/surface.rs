@@ -38,6 +38,7 @@ pub struct Surface {
 
 /// The shading normal bent by the material's normal map `which` ([`TEXTURE_NORMAL`] or
 /// [`TEXTURE_COAT_NORMAL`], its x and y scaled by `scale`). Twin of WGSL `normal_mapped`.
+#[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn normal_mapped(
     scene: &CpuScene,

@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Checks that the CPU backend's path tracer is inlined whole into its row renderer. `render_row`
+# is compiled once per instruction-set level (crates/cpu/src/row.rs); a function it calls that
+# the compiler leaves out of line is compiled for the baseline instead (SSE2: no AVX, a libm
+# call for every `floor`), and costs a call that saves every live vector register: texture
+# lookups so left out were 17% of textured-sphere's time. Builds the release binary and fails,
+# naming them, when it holds a function of a module the row runs (every module of
+# pathlight-cpu but the renderer's setup in lib.rs, `cpu_scene`, `display` and the level's
+# choice in `row`), apart from `textures::alpha_stops`, the alpha test of cut-out triangles,
+# left out on purpose (rare, and large).
+#
+#   tools/check-inlined.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+cargo build --release --locked -p pathlight
+hot='area_light|bvh|camera|diffuse|environment|integrator|intersect|light_sample|lights|lobes'
+hot+='|material|metal_rough|microfacet|packet|point_light|sampler|sampling|sheen|sun_light'
+hot+='|surface|textures|tracer'
+# Function symbols (text, weak), demangled, without their hashes: those of a hot module, or
+# of `row` but the level's choice (`InstructionSet`, `UnknownLevel`) and the per-level entry
+# points.
+out_of_line=$(nm -C target/release/pathlight |
+    awk '$2 ~ /^[tTwW]$/ { $1 = ""; $2 = ""; sub(/^ +/, ""); print }' |
+    sed 's/::h[0-9a-f]\{16\}$//' |
+    grep -P "^<?pathlight_cpu::(($hot)::|row::(?!InstructionSet::|UnknownLevel |render_row_with$|render_row_x86_64_))" |
+    grep -v '^pathlight_cpu::textures::alpha_stops$' |
+    sort -u || true)
+if [ -n "$out_of_line" ]; then
+    echo "functions of the CPU path tracer left out of line (compiled for the baseline);" >&2
+    echo "mark them #[inline(always)]:" >&2
+    echo "$out_of_line" >&2
+    exit 1
+fi
+echo "the CPU path tracer is inlined into its row renderer"
