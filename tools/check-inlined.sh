@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
-# Checks that the CPU backend's path tracer is inlined whole into its row renderer. `render_row`
-# is compiled once per instruction-set level (crates/cpu/src/row.rs); a function it calls that
-# the compiler leaves out of line is compiled for the baseline instead (SSE2: no AVX, a libm
-# call for every `floor`), and costs a call that saves every live vector register: texture
-# lookups so left out were 17% of textured-sphere's time. Builds the release binary and fails,
-# naming them, when it holds a function of a module the row runs (every module of
-# pathlight-cpu but the renderer's setup in lib.rs, `cpu_scene`, `display` and the level's
-# choice in `row`), apart from `textures::alpha_stops`, the alpha test of cut-out triangles,
-# left out on purpose (rare, and large).
+# Checks that the CPU backend's path tracer is inlined whole into its row renderer.
+# `render_row` is compiled once per instruction-set level (crates/cpu/src/row.rs); a function
+# it calls that the compiler leaves out of line is compiled for the baseline instead (SSE2: no
+# AVX, a libm call for every `floor`) and costs a call that saves every live vector register
+# (texture lookups were left out so: 17% of textured-sphere's profile). Builds the release
+# binary and fails, naming them, when it holds a function of a module the row runs (every
+# module of pathlight-cpu but the renderer's setup in lib.rs, `cpu_scene`, `display` and the
+# level's choice in `row`), apart from `textures::alpha_stops`, the alpha test of cut-out
+# triangles, left out on purpose (rare, and large).
 #
 #   tools/check-inlined.sh
 set -euo pipefail
