@@ -108,7 +108,7 @@ fn cylinder_u(frame: Frame, radial: Vec3A) -> f32 {
 
 /// Twin of WGSL `surface_at`, except that sphere and cylinder texture coordinates are
 /// computed only for materials with a texture, the only ones that read them (zero
-/// otherwise), with polynomial `atan2` and `acos` ([`sphere_uv`], [`cylinder_u`]).
+/// otherwise), with polynomial `atan2` and `acos` (`sphere_uv`, `cylinder_u`).
 #[inline(always)]
 pub fn surface_at(cpu_scene: &CpuScene, hit: &Hit, ray: &Ray) -> Surface {
     let scene = cpu_scene;
