@@ -234,7 +234,7 @@ impl Device {
                 "--accel {} needs the GPU backend; the CPU backend has only the BVH",
                 accel.name()
             ),
-            Device::Cpu if kernel != Kernel::Megakernel => {
+            Device::Cpu if kernel == Kernel::Wavefront => {
                 anyhow::bail!("--gpu-kernel {} needs the GPU backend", kernel.name())
             }
             Device::Cpu => Box::new(cpu_renderer(scene, prepared)?),

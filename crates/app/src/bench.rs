@@ -30,7 +30,8 @@ struct Measurement {
     /// Column label in the seed table, or the scheme's name.
     label: String,
     accel: String,
-    /// How the GPU integrator is split into kernels (`megakernel` on the CPU backend too).
+    /// How the GPU integrator is split into kernels, and how that was chosen (`-` on the CPU
+    /// backend).
     gpu_kernel: String,
     without: Vec<String>,
     width: u32,
@@ -190,7 +191,7 @@ fn measure(
     Ok(Measurement {
         label: String::new(),
         accel: accel.name().into(),
-        gpu_kernel: pathlight_gpu::Kernel::from(args.gpu_kernel).name().into(),
+        gpu_kernel: renderer.kernel().unwrap_or_else(|| "-".into()),
         without: Vec::new(),
         width,
         height,
@@ -220,7 +221,7 @@ fn print_single(report: &Report) {
     println!("scene        {}{without}", report.scene);
     println!("device       {}", report.device_line());
     println!(
-        "settings     {}x{}, max_depth {}, 1 spp per frame, accel {}, {}",
+        "settings     {}x{}, max_depth {}, 1 spp per frame, accel {}, kernel {}",
         m.width, m.height, m.max_depth, m.accel, m.gpu_kernel
     );
     println!(

@@ -167,7 +167,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub device: DeviceArgs,
     /// How the integrator is split into kernels (GPU backend); the image is the same.
-    #[arg(long, value_enum, default_value_t = GpuKernelArg::Megakernel)]
+    #[arg(long, value_enum, default_value_t = GpuKernelArg::Auto)]
     pub gpu_kernel: GpuKernelArg,
     /// List the adapters found and exit.
     #[arg(long)]
@@ -277,11 +277,12 @@ impl From<AccelArg> for pathlight_gpu::Accel {
 pub enum GpuKernelArg {
     /// One kernel follows each path from the camera to its end.
     Megakernel,
-    /// Kernels over queues of paths, one segment of every path at a time: faster on lavapipe
-    /// except for deep paths in small images; not yet measured on a GPU in this form (an
-    /// earlier one was faster at 1920x1080, slower at 500x500; BENCHMARKS.md, "The wavefront
-    /// split").
+    /// Kernels over queues of paths, one segment of every path at a time: faster where a
+    /// segment holds many paths (large images, long paths), slower on short paths
+    /// (BENCHMARKS.md, "The wavefront split").
     Wavefront,
+    /// Both timed in turn on the first whole passes of the image (two each), the faster kept.
+    Auto,
 }
 
 impl From<GpuKernelArg> for pathlight_gpu::Kernel {
@@ -289,6 +290,7 @@ impl From<GpuKernelArg> for pathlight_gpu::Kernel {
         match arg {
             GpuKernelArg::Megakernel => Self::Megakernel,
             GpuKernelArg::Wavefront => Self::Wavefront,
+            GpuKernelArg::Auto => Self::Auto,
         }
     }
 }
@@ -314,7 +316,7 @@ pub struct BenchArgs {
     #[arg(long, value_enum, default_value_t = AccelArg::Bvh)]
     pub accel: AccelArg,
     /// How the integrator is split into kernels (GPU backend); the image is the same.
-    #[arg(long, value_enum, default_value_t = GpuKernelArg::Megakernel)]
+    #[arg(long, value_enum, default_value_t = GpuKernelArg::Auto)]
     pub gpu_kernel: GpuKernelArg,
     /// Leave out the object of this name (repeatable), e.g. `--without vase`.
     #[arg(long, value_name = "NAME")]

@@ -243,6 +243,9 @@ fn render_to_file(
     }
     progress.finish();
     let render_time = render_started.elapsed();
+    if let Some(kernel) = renderer.kernel() {
+        note!("kernel: {kernel}");
+    }
     let spp = renderer.samples_done();
     let samples_per_second = progress.samples_per_second(spp);
     let state = state_of(renderer.as_ref())?;

@@ -17,6 +17,12 @@ pub trait Renderer {
     /// Where it renders, for messages and reports (the adapter, or the CPU and its threads).
     fn device(&self) -> String;
 
+    /// How the integrator is split into kernels, and how that was chosen, for messages and
+    /// reports; `None` where there is one way (the CPU backend).
+    fn kernel(&self) -> Option<String> {
+        None
+    }
+
     /// Image width and height in pixels.
     fn size(&self) -> (u32, u32);
 

@@ -16,6 +16,7 @@ use pathlight_core::{
 use pathlight_scene::{Camera, RenderSettings};
 
 use crate::context::{GpuContext, describe};
+use crate::kernel_trial::{KernelChoice, KernelTrial};
 use crate::pipeline::{bind_buffers, create_compute_pipeline, storage_entry};
 use crate::scene_buffers::SceneBuffers;
 use crate::wavefront::{WAVEFRONT_ENTRY_POINTS, Wavefront};
@@ -31,6 +32,9 @@ const MAX_BATCH_SAMPLES: u32 = 256;
 pub const MAX_STACK: u32 = 64;
 /// Workgroup edge of the integrator (`@workgroup_size(8, 8)`).
 const WORKGROUP: u32 = 8;
+/// The `auto` kernel's trial renders whole passes once a pass takes at most about this many
+/// submissions' time ([`TARGET_SUBMISSION`]); until then the megakernel renders bands of rows.
+const TRIAL_PASS_SUBMISSIONS: u32 = 4;
 
 /// How the integrator finds the nearest hit. Every scheme finds the same hit (a test checks
 /// it); the slower two reproduce the seed's frame-rate table (`pathlight bench --accel`).
@@ -79,6 +83,9 @@ pub enum Kernel {
     Megakernel,
     /// Kernels over queues of paths, one segment of every path at a time (`wavefront.wgsl`).
     Wavefront,
+    /// Both, timed in turn on the first whole passes of the image, the faster kept
+    /// ([`crate::kernel_trial`]).
+    Auto,
 }
 
 impl Kernel {
@@ -87,6 +94,7 @@ impl Kernel {
         match self {
             Kernel::Megakernel => "megakernel",
             Kernel::Wavefront => "wavefront",
+            Kernel::Auto => "auto",
         }
     }
 }
@@ -184,8 +192,15 @@ pub struct GpuRenderer {
     batch_samples: u32,
     /// Whether the piece size follows the measured speed (see [`Self::set_piece`]).
     adaptive: bool,
-    /// The wavefront kernels, when they render instead of `pipeline`.
+    /// The kernel asked for.
+    kernel: Kernel,
+    /// The wavefront kernels, when the kernel asked for may use them.
     wavefront: Option<Wavefront>,
+    /// Whether the wavefront renders instead of `pipeline` now.
+    use_wavefront: bool,
+    /// The `auto` kernel's trial while it is under way, then its outcome.
+    trial: Option<KernelTrial>,
+    choice: Option<KernelChoice>,
 }
 
 impl GpuRenderer {
@@ -258,7 +273,11 @@ impl GpuRenderer {
             adaptive: true,
             params,
             cursor: SampleCursor::default(),
+            kernel: Kernel::Megakernel,
             wavefront: None,
+            use_wavefront: false,
+            trial: None,
+            choice: None,
         })
     }
 
@@ -275,9 +294,59 @@ impl GpuRenderer {
     pub fn set_kernel(&mut self, kernel: Kernel) -> Result<(), RenderError> {
         self.wavefront = match kernel {
             Kernel::Megakernel => None,
-            Kernel::Wavefront => Some(self.wavefront_kernels()?),
+            Kernel::Wavefront | Kernel::Auto => Some(self.wavefront_kernels()?),
         };
+        self.kernel = kernel;
+        self.start_trial();
         Ok(())
+    }
+
+    /// Renders with the kernel asked for, or, for `auto`, starts its trial over.
+    fn start_trial(&mut self) {
+        self.use_wavefront = self.kernel == Kernel::Wavefront;
+        self.trial = (self.kernel == Kernel::Auto).then(KernelTrial::default);
+        self.choice = None;
+    }
+
+    /// The wavefront kernels when they render now.
+    fn active_wavefront(&self) -> Option<&Wavefront> {
+        self.wavefront.as_ref().filter(|_| self.use_wavefront)
+    }
+
+    /// For the `auto` kernel's trial, while it is under way: the next whole pass, timed,
+    /// when a pass is starting and the caller renders whole passes (`whole_passes`) or a
+    /// pass takes at most about [`TRIAL_PASS_SUBMISSIONS`] submissions' time; whether it
+    /// rendered one.
+    fn trial_pass(&mut self, whole_passes: bool) -> Result<bool, RenderError> {
+        let Some(kernel) = self.trial.as_ref().map(KernelTrial::next) else {
+            return Ok(false);
+        };
+        let height = self.params.height;
+        let short_pass = self.rows_per_dispatch * TRIAL_PASS_SUBMISSIONS >= height;
+        if self.cursor.in_pass() || !(whole_passes || short_pass) {
+            return Ok(false);
+        }
+        self.use_wavefront = kernel == Kernel::Wavefront;
+        let started = Instant::now();
+        self.submit(0, height, 1);
+        self.wait()?;
+        let elapsed = started.elapsed();
+        log::debug!(
+            "kernel trial: a pass with the {} took {elapsed:?}",
+            kernel.name()
+        );
+        self.cursor.add_passes(1);
+        if let Some(choice) = self.trial.as_mut().and_then(|t| t.record(elapsed)) {
+            log::info!("kernel: {}", choice.describe());
+            self.use_wavefront = choice.kernel == Kernel::Wavefront;
+            self.trial = None;
+            self.choice = Some(choice);
+            if self.adaptive {
+                let best = choice.megakernel.min(choice.wavefront);
+                self.reschedule(best, 1);
+            }
+        }
+        Ok(true)
     }
 
     /// The wavefront kernels for the scene, the features and the image size.
@@ -325,7 +394,7 @@ impl GpuRenderer {
     /// Queues `samples` samples per pixel for rows `row .. row + rows`.
     fn submit(&self, row: u32, rows: u32, samples: u32) {
         // The wavefront takes the band in waves of paths its dispatches can hold.
-        let wave = self.wavefront.as_ref().map_or(rows, Wavefront::rows);
+        let wave = self.active_wavefront().map_or(rows, Wavefront::rows);
         for start in (row..row + rows).step_by(wave as usize) {
             self.submit_wave(start, wave.min(row + rows - start), samples);
         }
@@ -344,7 +413,7 @@ impl GpuRenderer {
             .queue
             .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
-        if let Some(wavefront) = &self.wavefront {
+        if let Some(wavefront) = self.active_wavefront() {
             wavefront.record(
                 &self.ctx.queue,
                 &mut encoder,
@@ -427,6 +496,14 @@ impl Renderer for GpuRenderer {
         describe(&self.ctx.adapter_info)
     }
 
+    fn kernel(&self) -> Option<String> {
+        Some(match (&self.choice, self.kernel) {
+            (Some(choice), _) => choice.describe(),
+            (None, Kernel::Auto) => "auto (not chosen yet: the first passes time both)".into(),
+            (None, kernel) => kernel.name().into(),
+        })
+    }
+
     fn size(&self) -> (u32, u32) {
         (self.params.width, self.params.height)
     }
@@ -455,6 +532,8 @@ impl Renderer for GpuRenderer {
             if self.wavefront.is_some() {
                 self.wavefront = Some(self.wavefront_kernels()?);
             }
+            // Which kernel is faster depends on the image size.
+            self.start_trial();
         }
         self.restart();
         Ok(())
@@ -500,6 +579,9 @@ impl Renderer for GpuRenderer {
         if samples == 0 {
             return Ok(0);
         }
+        if self.trial_pass(false)? {
+            return Ok(1);
+        }
         if self.cursor.in_pass() || self.rows_per_dispatch < self.params.height {
             let done = self.step_frame(TARGET_SUBMISSION)?;
             return Ok(u32::from(done));
@@ -507,9 +589,11 @@ impl Renderer for GpuRenderer {
         let started = Instant::now();
         self.submit(0, self.params.height, samples);
         self.wait()?;
+        let elapsed = started.elapsed();
+        log::debug!("{samples} samples of every pixel: {elapsed:?}");
         self.cursor.add_passes(samples);
         if self.adaptive {
-            self.reschedule(started.elapsed(), samples);
+            self.reschedule(elapsed, samples);
         }
         Ok(samples)
     }
@@ -518,6 +602,9 @@ impl Renderer for GpuRenderer {
     /// Rows `0 .. cursor().rows_ahead` of an incomplete frame hold one sample more than the
     /// others.
     fn step_frame(&mut self, target: Duration) -> Result<bool, RenderError> {
+        if self.trial_pass(false)? {
+            return Ok(true);
+        }
         let height = self.params.height;
         let band = self.cursor.next_band(self.rows_per_dispatch, height);
         let rows = band.len() as u32;
@@ -525,6 +612,7 @@ impl Renderer for GpuRenderer {
         self.submit(band.start, rows, 1);
         self.wait()?;
         let elapsed = started.elapsed();
+        log::debug!("rows {}..{}, one sample: {elapsed:?}", band.start, band.end);
         if self.adaptive {
             // Next band: scale by the measured time, in whole workgroups of rows.
             let scale = target.as_secs_f64() / elapsed.as_secs_f64().max(1e-6);
@@ -538,6 +626,9 @@ impl Renderer for GpuRenderer {
 
     /// The rest of the pass in progress, or a whole one, as one dispatch not waited for.
     fn queue_frame(&mut self) -> Result<(), RenderError> {
+        if self.trial_pass(true)? {
+            return Ok(());
+        }
         let height = self.params.height;
         let band = self.cursor.next_band(height, height);
         self.submit(band.start, band.len() as u32, 1);
@@ -693,7 +784,8 @@ pub struct IntegratorKernel {
 }
 
 impl IntegratorKernel {
-    /// The kernels the renderer compiles as `kernel` for `scene`, `settings` and `accel`.
+    /// The kernels the renderer compiles as `kernel` for `scene`, `settings` and `accel`
+    /// (`auto` is the two kernels: it asks for one of them).
     pub fn of(
         scene: &PreparedScene,
         settings: &RenderSettings,
@@ -717,6 +809,13 @@ impl IntegratorKernel {
         let (module, entry_points) = match kernel {
             Kernel::Megakernel => ("integrator", &["render"][..]),
             Kernel::Wavefront => ("wavefront", &WAVEFRONT_ENTRY_POINTS[..]),
+            Kernel::Auto => {
+                return Err(RenderError::Pipeline {
+                    label: "auto".into(),
+                    message: "`auto` compiles both kernels: ask for `megakernel` or `wavefront`"
+                        .into(),
+                });
+            }
         };
         let source = wgsl::assemble(module, &[("STACK_SIZE", stack_size)]).map_err(|err| {
             RenderError::Pipeline {

@@ -5,6 +5,7 @@
 pub mod context;
 pub mod display;
 pub mod gpu_renderer;
+pub mod kernel_trial;
 pub mod pipeline;
 pub mod scene_buffers;
 pub mod wavefront;

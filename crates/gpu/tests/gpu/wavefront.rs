@@ -1,6 +1,7 @@
 //! The wavefront kernels against the megakernel: the same sums bit for bit (radiance and
 //! auxiliary images), the same ray and dropped-sample counts, whatever the scene's features,
-//! the path length, and however the work is cut into bands of rows and batches of samples.
+//! the path length, and however the work is cut into bands of rows and batches of samples;
+//! and the `auto` kernel, which renders its first passes with both.
 
 use pathlight_core::{Accumulation, PreparedScene, Renderer};
 use pathlight_gpu::{Accel, GpuRenderer, Kernel};
@@ -8,11 +9,13 @@ use pathlight_scene::Scene;
 
 use crate::common::{context, repo, scene};
 
-/// What a render leaves: the exact sums, and the rays traced and samples dropped.
+/// What a render leaves: the exact sums, the rays traced and samples dropped, and the
+/// renderer's report of its kernel.
 struct Outcome {
     accumulation: Accumulation,
     rays: u64,
     dropped: u64,
+    kernel: String,
 }
 
 /// Renders `scene` to `spp` with `kernel`, `rows` rows and `samples` samples per dispatch.
@@ -35,13 +38,27 @@ fn render(scene: &Scene, kernel: Kernel, spp: u32, rows: u32, samples: u32) -> O
         accumulation: renderer.accumulation().unwrap(),
         rays: renderer.rays_traced().unwrap(),
         dropped: renderer.samples_dropped().unwrap(),
+        kernel: renderer.kernel().unwrap(),
     }
 }
 
-/// Renders `scene` with both kernels and asserts the outcomes are the same.
+/// Renders `scene` with the megakernel and the wavefront and asserts the outcomes are the
+/// same.
 fn assert_same(label: &str, scene: &Scene, spp: u32, rows: u32, samples: u32) {
-    let mega = render(scene, Kernel::Megakernel, spp, rows, samples);
     let wave = render(scene, Kernel::Wavefront, spp, rows, samples);
+    assert_same_as_megakernel(label, scene, spp, rows, samples, &wave);
+}
+
+/// Renders `scene` with the megakernel and asserts the outcome is `wave`'s.
+fn assert_same_as_megakernel(
+    label: &str,
+    scene: &Scene,
+    spp: u32,
+    rows: u32,
+    samples: u32,
+    wave: &Outcome,
+) {
+    let mega = render(scene, Kernel::Megakernel, spp, rows, samples);
     assert!(mega.rays > 0, "{label}: no rays traced");
     assert_eq!(mega.rays, wave.rays, "{label}: rays traced");
     assert_eq!(mega.dropped, wave.dropped, "{label}: samples dropped");
@@ -116,4 +133,29 @@ fn wavefront_counts_the_samples_it_drops() {
     let wave = render(&s, Kernel::Wavefront, 2, 16, 2);
     assert!(wave.dropped > 10, "{} of 512 samples counted", wave.dropped);
     assert_same("NaN emission", &s, 2, 16, 2);
+}
+
+#[test]
+fn auto_renders_its_first_passes_with_both_kernels_then_keeps_one() {
+    let s = scene("refs/cornell-spheres.toml", 24, 6, 4);
+    // Bands of 8 rows (a pass short enough to time whole), then batches of 3 samples.
+    for (rows, samples) in [(8, 1), (24, 3)] {
+        let label = format!("auto, {rows} rows, {samples} samples");
+        let auto = render(&s, Kernel::Auto, 6, rows, samples);
+        assert!(
+            ["megakernel (auto: ", "wavefront (auto: "]
+                .iter()
+                .any(|k| auto.kernel.starts_with(k)),
+            "{label}: {}",
+            auto.kernel
+        );
+        assert_same_as_megakernel(&label, &s, 6, rows, samples, &auto);
+    }
+    // Three passes: the wavefront has had one, the trial goes on.
+    let early = render(&s, Kernel::Auto, 3, 24, 1);
+    assert!(
+        early.kernel.starts_with("auto (not chosen yet"),
+        "{}",
+        early.kernel
+    );
 }
