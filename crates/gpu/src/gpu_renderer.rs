@@ -614,12 +614,8 @@ impl Renderer for GpuRenderer {
         let elapsed = started.elapsed();
         log::debug!("rows {}..{}, one sample: {elapsed:?}", band.start, band.end);
         if self.adaptive {
-            // Next band: scale by the measured time, in whole workgroups of rows.
-            let scale = target.as_secs_f64() / elapsed.as_secs_f64().max(1e-6);
-            let workgroups =
-                (f64::from(rows) * scale.clamp(0.5, 2.0) / f64::from(WORKGROUP)).round();
             self.rows_per_dispatch =
-                (workgroups as u32 * WORKGROUP).clamp(WORKGROUP.min(height), height);
+                next_band_rows(self.rows_per_dispatch, rows, elapsed, target, height);
         }
         Ok(self.cursor.add_band(band.end, height))
     }
@@ -699,6 +695,17 @@ impl Renderer for GpuRenderer {
 }
 
 /// Bytes of the accumulation buffer for `params`' image, or why the device cannot bind it.
+/// Rows of the next band: as many as `target` renders at the speed of the last band
+/// (`rows` rows in `elapsed`), between half and twice the rows `asked` for it (a pass's last
+/// band is cut short, so the size asked for is the base, not the band's), in whole
+/// workgroups of rows, at most `height`.
+fn next_band_rows(asked: u32, rows: u32, elapsed: Duration, target: Duration, height: u32) -> u32 {
+    let in_target = f64::from(rows) * target.as_secs_f64() / elapsed.as_secs_f64().max(1e-6);
+    let asked = f64::from(asked);
+    let workgroups = (in_target.clamp(0.5 * asked, 2.0 * asked) / f64::from(WORKGROUP)).round();
+    (workgroups as u32 * WORKGROUP).clamp(WORKGROUP.min(height), height)
+}
+
 fn accumulation_size(device: &wgpu::Device, params: &GpuRenderParams) -> Result<u64, RenderError> {
     per_pixel_size(
         device,
@@ -857,4 +864,36 @@ fn stack_size(scene: &PreparedScene) -> u32 {
         .stack_bound
         .next_multiple_of(8)
         .min(MAX_STACK)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TARGET: Duration = TARGET_SUBMISSION;
+
+    fn ms(n: f64) -> Duration {
+        Duration::from_secs_f64(n / 1e3)
+    }
+
+    #[test]
+    fn bands_grow_at_most_twofold_to_a_whole_pass() {
+        // 32 rows in 1 ms: 3200 rows would fit the target; twice the band is the limit.
+        assert_eq!(next_band_rows(32, 32, ms(1.0), TARGET, 500), 64);
+        assert_eq!(next_band_rows(256, 256, ms(1.0), TARGET, 500), 500);
+        // At the target's speed the size holds; slower bands shrink, at most by half.
+        assert_eq!(next_band_rows(96, 96, TARGET, TARGET, 500), 96);
+        assert_eq!(next_band_rows(96, 96, TARGET * 10, TARGET, 500), 48);
+        // Never below a workgroup of rows, or the image's height when it is smaller.
+        assert_eq!(next_band_rows(8, 8, TARGET * 10, TARGET, 500), 8);
+        assert_eq!(next_band_rows(8, 5, TARGET * 10, TARGET, 5), 5);
+    }
+
+    #[test]
+    fn a_passs_last_band_cut_short_does_not_shrink_the_next() {
+        // 256 rows asked for, 20 left in the pass (rows 480..500): the next band is twice
+        // the 256, the whole image, not twice the 20 (which kept a 500-row image in bands
+        // for good: 40, 80, 160, 220, 440, 60, ...).
+        assert_eq!(next_band_rows(256, 20, ms(0.4), TARGET, 500), 500);
+    }
 }
