@@ -13,6 +13,9 @@ use crate::shading::Shading;
 /// A progressive render: samples are added to every pixel in turn, and the image at any
 /// moment is the mean of the samples so far. Sample `i` of a pixel is the same whatever
 /// batches the work was split into, so the image depends only on the sample count.
+/// A GPU renderer that chooses its kernel by timing (`auto`) renders its first whole passes
+/// a few at a time, waiting for each step, in whichever of [`Self::advance`],
+/// [`Self::step_frame`] or [`Self::queue_frame`] comes first.
 pub trait Renderer {
     /// Where it renders, for messages and reports (the adapter, or the CPU and its threads).
     fn device(&self) -> String;

@@ -313,30 +313,44 @@ impl GpuRenderer {
         self.wavefront.as_ref().filter(|_| self.use_wavefront)
     }
 
-    /// For the `auto` kernel's trial, while it is under way: the next whole pass, timed,
-    /// when a pass is starting and the caller renders whole passes (`whole_passes`) or a
-    /// pass takes at most about [`TRIAL_PASS_SUBMISSIONS`] submissions' time; whether it
-    /// rendered one.
-    fn trial_pass(&mut self, whole_passes: bool) -> Result<bool, RenderError> {
-        let Some(kernel) = self.trial.as_ref().map(KernelTrial::next) else {
-            return Ok(false);
+    /// For the `auto` kernel's trial, while it is under way: its next step, timed, when a
+    /// pass is starting and the caller renders whole passes (`whole_passes`) or a pass takes
+    /// at most about [`TRIAL_PASS_SUBMISSIONS`] submissions' time. A step is whole passes
+    /// (at most `max_passes`): as frames, a pass a submission (`frames`), or as one batch of
+    /// samples, the way the caller renders them. Returns the passes rendered.
+    fn trial_step(
+        &mut self,
+        whole_passes: bool,
+        frames: bool,
+        max_passes: u32,
+    ) -> Result<u32, RenderError> {
+        let Some((kernel, passes)) = self.trial.as_ref().map(|t| (t.next(), t.passes())) else {
+            return Ok(0);
         };
         let height = self.params.height;
         let short_pass = self.rows_per_dispatch * TRIAL_PASS_SUBMISSIONS >= height;
         if self.cursor.in_pass() || !(whole_passes || short_pass) {
-            return Ok(false);
+            return Ok(0);
         }
+        let passes = passes.min(max_passes);
         self.use_wavefront = kernel == Kernel::Wavefront;
         let started = Instant::now();
-        self.submit(0, height, 1);
+        if frames {
+            for _ in 0..passes {
+                self.submit(0, height, 1);
+                self.cursor.add_passes(1);
+            }
+        } else {
+            self.submit(0, height, passes);
+            self.cursor.add_passes(passes);
+        }
         self.wait()?;
         let elapsed = started.elapsed();
         log::debug!(
-            "kernel trial: a pass with the {} took {elapsed:?}",
+            "kernel trial: {passes} passes with the {} took {elapsed:?}",
             kernel.name()
         );
-        self.cursor.add_passes(1);
-        if let Some(choice) = self.trial.as_mut().and_then(|t| t.record(elapsed)) {
+        if let Some(choice) = self.trial.as_mut().and_then(|t| t.record(elapsed, passes)) {
             log::info!("kernel: {}", choice.describe());
             self.use_wavefront = choice.kernel == Kernel::Wavefront;
             self.trial = None;
@@ -346,7 +360,7 @@ impl GpuRenderer {
                 self.reschedule(best, 1);
             }
         }
-        Ok(true)
+        Ok(passes)
     }
 
     /// The wavefront kernels for the scene, the features and the image size.
@@ -579,8 +593,9 @@ impl Renderer for GpuRenderer {
         if samples == 0 {
             return Ok(0);
         }
-        if self.trial_pass(false)? {
-            return Ok(1);
+        let trial = self.trial_step(false, false, max_samples)?;
+        if trial > 0 {
+            return Ok(trial);
         }
         if self.cursor.in_pass() || self.rows_per_dispatch < self.params.height {
             let done = self.step_frame(TARGET_SUBMISSION)?;
@@ -602,7 +617,7 @@ impl Renderer for GpuRenderer {
     /// Rows `0 .. cursor().rows_ahead` of an incomplete frame hold one sample more than the
     /// others.
     fn step_frame(&mut self, target: Duration) -> Result<bool, RenderError> {
-        if self.trial_pass(false)? {
+        if self.trial_step(false, true, u32::MAX)? > 0 {
             return Ok(true);
         }
         let height = self.params.height;
@@ -622,7 +637,7 @@ impl Renderer for GpuRenderer {
 
     /// The rest of the pass in progress, or a whole one, as one dispatch not waited for.
     fn queue_frame(&mut self) -> Result<(), RenderError> {
-        if self.trial_pass(true)? {
+        if self.trial_step(true, true, u32::MAX)? > 0 {
             return Ok(());
         }
         let height = self.params.height;

@@ -7,49 +7,79 @@ use std::time::Duration;
 
 use crate::Kernel;
 
-/// Timed passes of each kernel before the choice. A kernel's first pass includes its first
-/// use on the device, so each kernel's faster pass counts.
-const PASSES_EACH: usize = 2;
+/// Timed steps of each kernel before the choice. A kernel's first step includes its first
+/// use on the device, so each kernel's faster step counts.
+const STEPS_EACH: usize = 2;
+/// Time a step aims at: shorter passes are timed several to a step, so that the wait for
+/// the device's answer (about 0.5 ms on an H200, as long as a 500x500 pass) and its jitter do
+/// not decide.
+const STEP_TARGET: Duration = Duration::from_millis(10);
+/// Most passes in one step.
+const MAX_STEP_PASSES: u32 = 8;
 
-/// A trial under way: the best pass time of each kernel so far.
-#[derive(Debug, Clone, Default)]
+/// A trial under way: the best time a pass took with each kernel so far.
+#[derive(Debug, Clone)]
 pub struct KernelTrial {
     megakernel: Option<Duration>,
     wavefront: Option<Duration>,
-    passes: usize,
+    steps: usize,
+    step_passes: u32,
 }
 
-/// The outcome of a trial: the kernel kept and each kernel's best pass.
+impl Default for KernelTrial {
+    fn default() -> Self {
+        Self {
+            megakernel: None,
+            wavefront: None,
+            steps: 0,
+            step_passes: 1,
+        }
+    }
+}
+
+/// The outcome of a trial: the kernel kept and each kernel's best time a pass.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct KernelChoice {
     /// The faster kernel (the megakernel on a tie).
     pub kernel: Kernel,
-    /// The megakernel's best pass.
+    /// The megakernel's best time a pass.
     pub megakernel: Duration,
-    /// The wavefront's best pass.
+    /// The wavefront's best time a pass.
     pub wavefront: Duration,
 }
 
 impl KernelTrial {
-    /// The kernel that renders the next timed pass: the two alternate, the megakernel first.
+    /// The kernel that renders the next step: the two alternate, the megakernel first.
     pub fn next(&self) -> Kernel {
-        if self.passes.is_multiple_of(2) {
+        if self.steps.is_multiple_of(2) {
             Kernel::Megakernel
         } else {
             Kernel::Wavefront
         }
     }
 
-    /// Records the time of the pass [`Self::next`] named; once every pass is timed, the
-    /// choice.
-    pub fn record(&mut self, elapsed: Duration) -> Option<KernelChoice> {
+    /// Whole passes the next step renders: one at first, then as many as the best pass so
+    /// far fits in [`STEP_TARGET`], at most [`MAX_STEP_PASSES`].
+    pub fn passes(&self) -> u32 {
+        self.step_passes
+    }
+
+    /// Records the time of a step of [`Self::next`]'s kernel that rendered `passes` passes;
+    /// once every step is timed, the choice.
+    pub fn record(&mut self, elapsed: Duration, passes: u32) -> Option<KernelChoice> {
+        let per_pass = elapsed / passes.max(1);
         let best = match self.next() {
             Kernel::Wavefront => &mut self.wavefront,
             _ => &mut self.megakernel,
         };
-        *best = Some(best.map_or(elapsed, |b| b.min(elapsed)));
-        self.passes += 1;
-        if self.passes < 2 * PASSES_EACH {
+        *best = Some(best.map_or(per_pass, |b| b.min(per_pass)));
+        self.steps += 1;
+        let fastest = self.megakernel.into_iter().chain(self.wavefront).min();
+        if let Some(fastest) = fastest {
+            let fit = STEP_TARGET.as_secs_f64() / fastest.as_secs_f64().max(1e-9);
+            self.step_passes = fit.clamp(1.0, f64::from(MAX_STEP_PASSES)) as u32;
+        }
+        if self.steps < 2 * STEPS_EACH {
             return None;
         }
         let (megakernel, wavefront) = (self.megakernel?, self.wavefront?);
@@ -81,52 +111,65 @@ impl KernelChoice {
 mod tests {
     use super::*;
 
-    fn ms(n: u64) -> Duration {
-        Duration::from_millis(n)
+    fn ms(n: f64) -> Duration {
+        Duration::from_secs_f64(n / 1e3)
     }
 
-    /// Runs a trial on pass times in the order the passes are rendered.
-    fn choose(times: &[u64]) -> Vec<(Kernel, Option<KernelChoice>)> {
+    /// Runs a trial on step times (each step as many passes as the trial asks for, each pass
+    /// as long as given): the kernel and passes of each step and the outcome.
+    fn choose(pass_ms: &[f64]) -> Vec<(Kernel, u32, Option<KernelChoice>)> {
         let mut trial = KernelTrial::default();
-        times
+        pass_ms
             .iter()
-            .map(|&t| (trial.next(), trial.record(ms(t))))
+            .map(|&t| {
+                let (kernel, passes) = (trial.next(), trial.passes());
+                (kernel, passes, trial.record(ms(t) * passes, passes))
+            })
             .collect()
     }
 
     #[test]
     fn the_kernels_alternate_and_each_ones_best_pass_decides() {
-        // The wavefront's first pass is slow (its first use), its second the fastest of all.
-        let steps = choose(&[10, 50, 9, 6]);
-        let order: Vec<Kernel> = steps.iter().map(|(k, _)| *k).collect();
+        // The wavefront's first step is slow (its first use), its second the fastest of all.
+        let steps = choose(&[10.0, 50.0, 9.0, 6.0]);
+        let order: Vec<Kernel> = steps.iter().map(|s| s.0).collect();
         use Kernel::{Megakernel, Wavefront};
         assert_eq!(order, [Megakernel, Wavefront, Megakernel, Wavefront]);
-        assert!(steps[..3].iter().all(|(_, c)| c.is_none()));
+        assert!(steps[..3].iter().all(|s| s.2.is_none()));
         assert_eq!(
-            steps[3].1,
+            steps[3].2,
             Some(KernelChoice {
                 kernel: Wavefront,
-                megakernel: ms(9),
-                wavefront: ms(6),
+                megakernel: ms(9.0),
+                wavefront: ms(6.0),
             })
         );
     }
 
     #[test]
+    fn short_passes_are_timed_several_to_a_step() {
+        // 10 ms passes: one a step. 2.5 ms: four. 0.5 ms: at most eight.
+        let passes = |t: f64| -> Vec<u32> { choose(&[t; 4]).iter().map(|s| s.1).collect() };
+        assert_eq!(passes(10.0), [1, 1, 1, 1]);
+        assert_eq!(passes(2.5), [1, 4, 4, 4]);
+        assert_eq!(passes(0.5), [1, 8, 8, 8]);
+        // A slow first use does not shrink the steps after a fast pass.
+        let steps = choose(&[40.0, 2.0, 2.0, 2.0]);
+        assert_eq!(steps.iter().map(|s| s.1).collect::<Vec<_>>(), [1, 1, 5, 5]);
+        // The times recorded are a pass's, not a step's.
+        assert_eq!(steps[3].2.unwrap().megakernel, ms(2.0));
+    }
+
+    #[test]
     fn the_megakernel_is_kept_when_faster_or_tied() {
-        assert_eq!(
-            choose(&[5, 6, 7, 8])[3].1.unwrap().kernel,
-            Kernel::Megakernel
-        );
-        assert_eq!(
-            choose(&[5, 6, 7, 5])[3].1.unwrap().kernel,
-            Kernel::Megakernel
-        );
+        let kernel = |t: &[f64]| choose(t)[3].2.unwrap().kernel;
+        assert_eq!(kernel(&[5.0, 6.0, 7.0, 8.0]), Kernel::Megakernel);
+        assert_eq!(kernel(&[5.0, 6.0, 7.0, 5.0]), Kernel::Megakernel);
     }
 
     #[test]
     fn the_choice_names_the_kernel_and_both_times() {
-        let text = choose(&[2, 3, 2, 1])[3].1.unwrap().describe();
+        let text = choose(&[2.0, 3.0, 2.0, 1.0])[3].2.unwrap().describe();
         assert_eq!(
             text,
             "wavefront (auto: a pass took 2.000 ms with the megakernel, 1.000 ms with the \

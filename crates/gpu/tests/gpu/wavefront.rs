@@ -137,11 +137,12 @@ fn wavefront_counts_the_samples_it_drops() {
 
 #[test]
 fn auto_renders_its_first_passes_with_both_kernels_then_keeps_one() {
-    let s = scene("refs/cornell-spheres.toml", 24, 6, 4);
+    // 32 samples: the trial takes at most 25 passes (a step of one, then three of up to 8).
+    let s = scene("refs/cornell-spheres.toml", 24, 32, 4);
     // Bands of 8 rows (a pass short enough to time whole), then batches of 3 samples.
     for (rows, samples) in [(8, 1), (24, 3)] {
         let label = format!("auto, {rows} rows, {samples} samples");
-        let auto = render(&s, Kernel::Auto, 6, rows, samples);
+        let auto = render(&s, Kernel::Auto, 32, rows, samples);
         assert!(
             ["megakernel (auto: ", "wavefront (auto: "]
                 .iter()
@@ -149,9 +150,10 @@ fn auto_renders_its_first_passes_with_both_kernels_then_keeps_one() {
             "{label}: {}",
             auto.kernel
         );
-        assert_same_as_megakernel(&label, &s, 6, rows, samples, &auto);
+        assert_same_as_megakernel(&label, &s, 32, rows, samples, &auto);
     }
-    // Three passes: the wavefront has had one, the trial goes on.
+    // Three samples: the trial's second step, the wavefront's first, is cut to two passes
+    // and the trial goes on.
     let early = render(&s, Kernel::Auto, 3, 24, 1);
     assert!(
         early.kernel.starts_with("auto (not chosen yet"),
