@@ -195,11 +195,12 @@ impl GpuContext {
     }
 
     /// Opens a device on `adapter` with the adapter's own limits (more storage buffers and
-    /// larger bindings than wgpu's defaults).
+    /// larger bindings than wgpu's defaults), and timestamp queries where it has them.
     pub fn from_adapter(adapter: &Adapter) -> Result<Self, RenderError> {
         let adapter_info = adapter.get_info();
         let descriptor = wgpu::DeviceDescriptor {
             label: Some("pathlight device"),
+            required_features: adapter.features() & crate::dispatch_times::FEATURES,
             required_limits: adapter.limits(),
             ..Default::default()
         };

@@ -16,6 +16,7 @@ use pathlight_core::{
 use pathlight_scene::{Camera, RenderSettings};
 
 use crate::context::{GpuContext, describe};
+use crate::dispatch_times::{self, DispatchTimes};
 use crate::kernel_trial::{KernelChoice, KernelTrial};
 use crate::pipeline::{bind_buffers, create_compute_pipeline, storage_entry};
 use crate::scene_buffers::SceneBuffers;
@@ -313,6 +314,57 @@ impl GpuRenderer {
         self.wavefront.as_ref().filter(|_| self.use_wavefront)
     }
 
+    /// Renders the next whole pass of the image (after finishing the pass under way) with a
+    /// timestamp after every dispatch, and returns each dispatch's GPU time in order, named:
+    /// `megakernel`, or the wavefront's `start`, `trace N` and `shade N` of segment N and
+    /// `finish`, a wave of rows after another. Refused where the device has no timestamp
+    /// queries inside compute passes, or a pass needs more than a query set holds.
+    pub fn profile_pass(&mut self) -> Result<Vec<(String, Duration)>, RenderError> {
+        let adapter = &self.ctx.adapter_info.name;
+        if !self
+            .ctx
+            .device
+            .features()
+            .contains(dispatch_times::FEATURES)
+        {
+            return Err(RenderError::Gpu(format!(
+                "{adapter} has no timestamp queries inside compute passes"
+            )));
+        }
+        if self.cursor.in_pass() {
+            self.queue_frame()?;
+        }
+        let height = self.params.height;
+        let (waves, per_wave) = match self.active_wavefront() {
+            Some(wavefront) => (
+                height.div_ceil(wavefront.rows()),
+                4 + 2 * self.params.max_depth,
+            ),
+            None => (1, 2),
+        };
+        let capacity = u64::from(waves) * u64::from(per_wave);
+        if capacity > u64::from(wgpu::QUERY_SET_MAX_QUERIES) {
+            return Err(RenderError::Gpu(format!(
+                "a pass takes {capacity} timestamps, more than a query set's {}",
+                wgpu::QUERY_SET_MAX_QUERIES
+            )));
+        }
+        let mut times = DispatchTimes::new(&self.ctx.device, capacity as u32);
+        self.submit_timed(0, height, 1, Some(&mut times));
+        self.cursor.add_passes(1);
+        let resolved = self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamps"),
+            size: times.size().max(8),
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
+        times.resolve(&mut encoder, &resolved);
+        self.ctx.queue.submit([encoder.finish()]);
+        let ticks: Vec<u64> = self.read_buffer(&resolved)?;
+        Ok(times.durations(&ticks, self.ctx.queue.get_timestamp_period()))
+    }
+
     /// For the `auto` kernel's trial, while it is under way: its next step, timed, when a
     /// pass is starting and the caller renders whole passes (`whole_passes`) or a pass takes
     /// at most about [`TRIAL_PASS_SUBMISSIONS`] submissions' time. A step is whole passes
@@ -407,15 +459,34 @@ impl GpuRenderer {
 
     /// Queues `samples` samples per pixel for rows `row .. row + rows`.
     fn submit(&self, row: u32, rows: u32, samples: u32) {
+        self.submit_timed(row, rows, samples, None);
+    }
+
+    /// [`Self::submit`], with the dispatches' timestamps written to `times`.
+    fn submit_timed(
+        &self,
+        row: u32,
+        rows: u32,
+        samples: u32,
+        mut times: Option<&mut DispatchTimes>,
+    ) {
         // The wavefront takes the band in waves of paths its dispatches can hold.
         let wave = self.active_wavefront().map_or(rows, Wavefront::rows);
         for start in (row..row + rows).step_by(wave as usize) {
-            self.submit_wave(start, wave.min(row + rows - start), samples);
+            let wave_rows = wave.min(row + rows - start);
+            self.submit_wave(start, wave_rows, samples, times.as_deref_mut());
         }
     }
 
-    /// Queues `samples` samples per pixel for rows `row .. row + rows` as one submission.
-    fn submit_wave(&self, row: u32, rows: u32, samples: u32) {
+    /// Queues `samples` samples per pixel for rows `row .. row + rows` as one submission,
+    /// writing the dispatches' timestamps to `times`.
+    fn submit_wave(
+        &self,
+        row: u32,
+        rows: u32,
+        samples: u32,
+        mut times: Option<&mut DispatchTimes>,
+    ) {
         let params = GpuRenderParams {
             sample_offset: self.cursor.next_sample(),
             batch_samples: samples,
@@ -437,6 +508,7 @@ impl GpuRenderer {
                 rows,
                 samples,
                 self.params.max_depth,
+                times,
             );
         } else {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -446,11 +518,17 @@ impl GpuRenderer {
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &self.scene.bind_group, &[]);
             pass.set_bind_group(1, &self.frame_bind_group, &[]);
+            if let Some(times) = times.as_deref_mut() {
+                times.begin(&mut pass);
+            }
             pass.dispatch_workgroups(
                 self.params.width.div_ceil(WORKGROUP),
                 rows.div_ceil(WORKGROUP),
                 1,
             );
+            if let Some(times) = times {
+                times.end(&mut pass, "megakernel".into());
+            }
         }
         self.ctx.queue.submit([encoder.finish()]);
     }

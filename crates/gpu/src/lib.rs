@@ -3,6 +3,7 @@
 //! renderer ([`GpuRenderer`]) and the viewer's display pass ([`display`]).
 
 pub mod context;
+pub mod dispatch_times;
 pub mod display;
 pub mod gpu_renderer;
 pub mod kernel_trial;

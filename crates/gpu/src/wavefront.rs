@@ -4,6 +4,7 @@
 use pathlight_core::RenderError;
 
 use crate::IntegratorKernel;
+use crate::dispatch_times::DispatchTimes;
 use crate::pipeline::{bind_buffers, create_compute_pipeline, storage_entry};
 
 /// The kernels' entry points in `wavefront.wgsl`.
@@ -159,7 +160,10 @@ impl Wavefront {
     }
 
     /// Records `samples` samples of `rows` rows (at most [`Self::rows`]) `width` wide,
-    /// `max_depth` segments each, in waves of as many samples as the path state holds, into `encoder`, with bind groups `scene` (0) and `frame` (1).
+    /// `max_depth` segments each, in waves of as many samples as the path state holds, into
+    /// `encoder`, with bind groups `scene` (0) and `frame` (1); with `times`, a timestamp
+    /// where the pass begins and after every dispatch (`start`, `trace N` and `shade N` of
+    /// segment N, `finish`), 4 + 2 `max_depth` a wave.
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -171,6 +175,7 @@ impl Wavefront {
         rows: u32,
         samples: u32,
         max_depth: u32,
+        mut times: Option<&mut DispatchTimes>,
     ) {
         queue.write_buffer(&self.counts, 4 * COUNT_SAMPLE, bytemuck::bytes_of(&0u32));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -180,14 +185,24 @@ impl Wavefront {
         pass.set_bind_group(0, scene, &[]);
         pass.set_bind_group(1, frame, &[]);
         pass.set_bind_group(2, &self.bind_group, &[]);
+        if let Some(times) = times.as_deref_mut() {
+            times.begin(&mut pass);
+        }
         let grid = (width.div_ceil(WORKGROUP), rows.div_ceil(WORKGROUP));
         // Segment s reads its dispatches from buffer s % 2 while its kernels fill the other.
-        let segment = |pass: &mut wgpu::ComputePass, s: u32, kernels: &[&wgpu::ComputePipeline]| {
+        let segment = |pass: &mut wgpu::ComputePass,
+                       times: &mut Option<&mut DispatchTimes>,
+                       s: u32,
+                       shade: bool| {
             let k = (s % 2) as usize;
             pass.set_bind_group(3, &self.dispatch_groups[1 - k], &[]);
-            for (kernel, offset) in kernels.iter().zip([0, 12]) {
+            let kernels = [("trace", &self.trace, 0), ("shade", &self.shade, 12)];
+            for (name, kernel, offset) in &kernels[..1 + usize::from(shade)] {
                 pass.set_pipeline(kernel);
-                pass.dispatch_workgroups_indirect(&self.dispatches[k], offset);
+                pass.dispatch_workgroups_indirect(&self.dispatches[k], *offset);
+                if let Some(times) = times.as_deref_mut() {
+                    times.end(pass, format!("{name} {}", s + 1));
+                }
             }
         };
         // As many samples of each pixel in a wave as the path state holds.
@@ -199,13 +214,19 @@ impl Wavefront {
             pass.set_bind_group(3, &self.dispatch_groups[0], &[]);
             pass.set_pipeline(&self.start);
             pass.dispatch_workgroups(grid.0, grid.1, wave);
+            if let Some(times) = times.as_deref_mut() {
+                times.end(&mut pass, "start".into());
+            }
             for s in 0..max_depth {
-                segment(&mut pass, s, &[&self.trace, &self.shade]);
+                segment(&mut pass, &mut times, s, true);
             }
             // The last segment's shadow rays.
-            segment(&mut pass, max_depth, &[&self.trace]);
+            segment(&mut pass, &mut times, max_depth, false);
             pass.set_pipeline(&self.finish);
             pass.dispatch_workgroups(grid.0, grid.1, 1);
+            if let Some(times) = times.as_deref_mut() {
+                times.end(&mut pass, "finish".into());
+            }
         }
     }
 }

@@ -5,6 +5,7 @@ mod display;
 mod extreme;
 mod furnace;
 mod metal_rough;
+mod profile;
 mod render;
 mod state;
 mod trace;

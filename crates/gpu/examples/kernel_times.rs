@@ -1,0 +1,84 @@
+//! Times each of the integrator's dispatches on the GPU, with timestamp queries between them
+//! ([`GpuRenderer::profile_pass`]): where a frame's time goes, kernel by kernel and, for the
+//! wavefront, segment by segment.
+//!
+//!   cargo run --release -p pathlight-gpu --example kernel_times -- [--wavefront] [--frames N] [SCENE]
+//!
+//! SCENE: a scene file (TOML or glTF); the built-in default scene when absent, each at its own
+//! size. Renders 16 untimed frames (one sample per pixel each, as `pathlight bench` does), then
+//! N profiled ones (20), and prints each dispatch's median time over them (summed over a
+//! frame's waves of rows), its share of the frame and the frame's total.
+
+use std::path::Path;
+use std::time::Duration;
+
+use anyhow::{Context, Result};
+use pathlight_core::{PreparedScene, Renderer};
+use pathlight_gpu::{Accel, GpuContext, GpuRenderer, Kernel};
+use pathlight_scene::{default_scene, load_scene_file};
+
+fn main() -> Result<()> {
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let kernel = if args.iter().any(|a| a == "--wavefront") {
+        Kernel::Wavefront
+    } else {
+        Kernel::Megakernel
+    };
+    let mut frames = 20;
+    if let Some(i) = args.iter().position(|a| a == "--frames") {
+        let value = args.get(i + 1).context("--frames needs a number")?;
+        frames = value.parse().with_context(|| format!("--frames {value}"))?;
+        args.drain(i..i + 2);
+    }
+    args.retain(|a| !a.starts_with("--"));
+    let scene = match args.first() {
+        Some(path) => load_scene_file(Path::new(path))?,
+        None => default_scene::load()?,
+    };
+    let ctx = GpuContext::new(None)?;
+    let prepared = PreparedScene::new(&scene)?;
+    let mut renderer =
+        GpuRenderer::new(&ctx, &prepared, &scene.camera, &scene.settings, Accel::Bvh)?;
+    renderer.set_kernel(kernel)?;
+    for _ in 0..16 {
+        renderer.queue_frame()?;
+    }
+    renderer.finish()?;
+
+    // Per dispatch name, in the order of a frame: its time in each profiled frame.
+    let mut times: Vec<(String, Vec<Duration>)> = Vec::new();
+    for frame in 0..frames {
+        for (name, time) in renderer.profile_pass()? {
+            match times.iter_mut().find(|(n, _)| *n == name) {
+                Some((_, per_frame)) if per_frame.len() > frame => per_frame[frame] += time,
+                Some((_, per_frame)) => per_frame.push(time),
+                None => times.push((name, vec![time])),
+            }
+        }
+    }
+    let medians: Vec<(String, f64)> = times
+        .into_iter()
+        .map(|(name, mut per_frame)| {
+            per_frame.sort();
+            (name, per_frame[per_frame.len() / 2].as_secs_f64() * 1e3)
+        })
+        .collect();
+    let total: f64 = medians.iter().map(|(_, ms)| ms).sum();
+    println!("device   {}", renderer.device());
+    println!(
+        "scene    {}x{}, max_depth {}, {}, median of {frames} frames",
+        scene.camera.width,
+        scene.camera.height,
+        scene.settings.max_depth,
+        kernel.name()
+    );
+    println!("{:<12} {:>9} {:>6}", "dispatch", "ms", "share");
+    for (name, ms) in &medians {
+        println!(
+            "{name:<12} {ms:>9.4} {:>5.1}%",
+            100.0 * ms / total.max(1e-12)
+        );
+    }
+    println!("{:<12} {total:>9.4}", "sum");
+    Ok(())
+}
