@@ -2,10 +2,11 @@
 //! ([`GpuRenderer::profile_pass`]): where a frame's time goes, kernel by kernel and, for the
 //! wavefront, segment by segment.
 //!
-//!   cargo run --release -p pathlight-gpu --example kernel_times -- [--wavefront] [--frames N] [SCENE]
+//!   cargo run --release -p pathlight-gpu --example kernel_times -- [--wavefront] [--frames N]
+//!       [--size WxH] [SCENE]
 //!
 //! SCENE: a scene file (TOML or glTF); the built-in default scene when absent, each at its own
-//! size. Renders 16 untimed frames (one sample per pixel each, as `pathlight bench` does), then
+//! size unless `--size` gives one. Renders 16 untimed frames (one sample per pixel each, as `pathlight bench` does), then
 //! N profiled ones (20), and prints each dispatch's median time over them (summed over a
 //! frame's waves of rows), its share of the frame and the frame's total.
 
@@ -24,17 +25,23 @@ fn main() -> Result<()> {
     } else {
         Kernel::Megakernel
     };
-    let mut frames = 20;
-    if let Some(i) = args.iter().position(|a| a == "--frames") {
-        let value = args.get(i + 1).context("--frames needs a number")?;
-        frames = value.parse().with_context(|| format!("--frames {value}"))?;
-        args.drain(i..i + 2);
-    }
+    let frames: usize = match option(&mut args, "--frames")? {
+        Some(value) => value.parse().with_context(|| format!("--frames {value}"))?,
+        None => 20,
+    };
+    let size = option(&mut args, "--size")?;
     args.retain(|a| !a.starts_with("--"));
-    let scene = match args.first() {
+    let mut scene = match args.first() {
         Some(path) => load_scene_file(Path::new(path))?,
         None => default_scene::load()?,
     };
+    if let Some(size) = size {
+        let parsed = size
+            .split_once('x')
+            .and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)));
+        (scene.camera.width, scene.camera.height) =
+            parsed.with_context(|| format!("--size {size}: not WxH"))?;
+    }
     let ctx = GpuContext::new(None)?;
     let prepared = PreparedScene::new(&scene)?;
     let mut renderer =
@@ -81,4 +88,17 @@ fn main() -> Result<()> {
     }
     println!("{:<12} {total:>9.4}", "sum");
     Ok(())
+}
+
+/// Removes option `name` and its value from `args`; the value, if the option is there.
+fn option(args: &mut Vec<String>, name: &str) -> Result<Option<String>> {
+    let Some(i) = args.iter().position(|a| a == name) else {
+        return Ok(None);
+    };
+    let value = args
+        .get(i + 1)
+        .with_context(|| format!("{name} needs a value"))?
+        .clone();
+    args.drain(i..i + 2);
+    Ok(Some(value))
 }
