@@ -8,7 +8,9 @@
 //! SCENE: a scene file (TOML or glTF); the built-in default scene when absent, each at its own
 //! size unless `--size` gives one. Renders 16 untimed frames (one sample per pixel each, as `pathlight bench` does), then
 //! N profiled ones (20), and prints each dispatch's median time over them (summed over a
-//! frame's waves of rows), its share of the frame and the frame's total.
+//! frame's waves of rows), its share of the frame and the frame's total. Check the total
+//! against `pathlight bench`'s frame time first: on an H200 the wavefront's 500x500 frames of
+//! the default scene took 4x longer profiled (BENCHMARKS.md, "The frame kernel by kernel").
 
 use std::path::Path;
 use std::time::Duration;

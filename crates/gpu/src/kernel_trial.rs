@@ -59,7 +59,7 @@ impl KernelTrial {
     }
 
     /// Whole passes the next step renders: one at first, then as many as the best pass so
-    /// far fits in [`STEP_TARGET`], at most [`MAX_STEP_PASSES`].
+    /// far fits in 10 ms (`STEP_TARGET`), at most 8 (`MAX_STEP_PASSES`).
     pub fn passes(&self) -> u32 {
         self.step_passes
     }
