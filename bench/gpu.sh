@@ -19,7 +19,8 @@
 #   bash bench/gpu.sh [--rounds N] [--frames N] [--cases LIST] [BIN...]
 #     BIN: pathlight binaries (default: a fresh release build), each optionally with options
 #     for all its runs in the same word, e.g. "target/release/pathlight --gpu-kernel
-#     wavefront" beside "target/release/pathlight"; --rounds 2; --frames 3000
+#     wavefront" beside "target/release/pathlight --gpu-kernel megakernel" (a bare binary
+#     takes its default kernel, `auto` since 3c468f3); --rounds 2; --frames 3000
 #     (the 500x500 cases; 1080p takes a tenth, 1m-triangles a third); --cases: a
 #     comma-separated subset of the names above.
 set -uo pipefail
