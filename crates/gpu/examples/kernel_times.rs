@@ -15,9 +15,10 @@
 use std::path::Path;
 use std::time::Duration;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use pathlight_core::{PreparedScene, Renderer};
 use pathlight_gpu::{Accel, GpuContext, GpuRenderer, Kernel};
+use pathlight_scene::settings::check_resolution;
 use pathlight_scene::{default_scene, load_scene_file};
 
 fn main() -> Result<()> {
@@ -31,6 +32,9 @@ fn main() -> Result<()> {
         Some(value) => value.parse().with_context(|| format!("--frames {value}"))?,
         None => 20,
     };
+    if frames == 0 {
+        bail!("--frames 0: at least one frame is profiled");
+    }
     let size = option(&mut args, "--size")?;
     args.retain(|a| !a.starts_with("--"));
     let mut scene = match args.first() {
@@ -43,6 +47,8 @@ fn main() -> Result<()> {
             .and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)));
         (scene.camera.width, scene.camera.height) =
             parsed.with_context(|| format!("--size {size}: not WxH"))?;
+        check_resolution(scene.camera.width, scene.camera.height)
+            .with_context(|| format!("--size {size}"))?;
     }
     let ctx = GpuContext::new(None)?;
     let prepared = PreparedScene::new(&scene)?;
