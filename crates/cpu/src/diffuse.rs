@@ -8,10 +8,10 @@
 //! (`sample_lobes`, `sample_area_light`, `sample_environment`, `eval_lobes`,
 //! `power_heuristic`, `shadow_ray`): the same operations in the same order. Scalar helpers
 //! are called as they are (`sin_cos_turns`, `power_heuristic`); those written on glam's
-//! `Vec3A` (`Frame`, `sample_cosine_hemisphere`, the dot product) are written again here on
-//! `[f32; 3]`, as the packet code keeps its lanes in plain arrays (`Vec3A` is one SSE
-//! register per vector), and the tests below hold each copy to its original. CPU only (on
-//! the GPU, threads are lanes already).
+//! `Vec3A` are written again on `[f32; 3]` (`Frame` and the dot product in [`crate::soa`],
+//! `sample_cosine_hemisphere` here), as the packet code keeps its lanes in plain arrays, and
+//! the tests hold each copy to its original. CPU only (on the GPU, threads are lanes
+//! already).
 
 use std::f32::consts::{FRAC_1_PI, PI};
 
@@ -23,9 +23,7 @@ use crate::intersect::Ray;
 use crate::microfacet::{BsdfSample, INVALID};
 use crate::packet::{Lanes, PACKET};
 use crate::sampling::{power_heuristic, sin_cos_turns};
-
-/// A vector per lane, stored per axis.
-type Lanes3 = [[f32; PACKET]; 3];
+use crate::soa::{Lanes3, dot, frame_around, lane, set_lane, to_world};
 
 /// A diffuse vertex with its BSDF sample, and what the path needs to go on from it.
 #[derive(Debug, Clone, Copy)]
@@ -123,52 +121,12 @@ impl Default for DiffuseLanes {
     }
 }
 
-/// Lane `l` of `a` as a vector.
-#[inline(always)]
-fn lane(a: &Lanes3, l: usize) -> Vec3A {
-    Vec3A::new(a[0][l], a[1][l], a[2][l])
-}
-
-/// Writes `v` to lane `l` of `a`.
-#[inline(always)]
-fn set_lane(a: &mut Lanes3, l: usize, v: Vec3A) {
-    for (axis, row) in a.iter_mut().enumerate() {
-        row[l] = v[axis];
-    }
-}
-
-/// `a . b` as glam computes it: `(x + y) + z`.
-#[inline(always)]
-fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
 /// `sample_cosine_hemisphere([ux, uy])`.
 #[inline(always)]
 fn cosine_hemisphere(ux: f32, uy: f32) -> [f32; 3] {
     let r = ux.sqrt();
     let (sin, cos) = sin_cos_turns(uy);
     [r * cos, r * sin, (1.0 - ux).max(0.0).sqrt()]
-}
-
-/// `Frame::around(n)`: tangent, bitangent, normal.
-#[inline(always)]
-fn frame_around(n: [f32; 3]) -> [[f32; 3]; 3] {
-    let s = if n[2] >= 0.0 { 1.0 } else { -1.0 };
-    let a = -1.0 / (s + n[2]);
-    let b = n[0] * n[1] * a;
-    [
-        [1.0 + s * n[0] * n[0] * a, s * b, -s * n[0]],
-        [b, s + n[1] * n[1] * a, -n[1]],
-        n,
-    ]
-}
-
-/// `Frame::to_world`.
-#[inline(always)]
-fn to_world(frame: &[[f32; 3]; 3], v: [f32; 3]) -> [f32; 3] {
-    let [t, b, n] = frame;
-    std::array::from_fn(|i| t[i] * v[0] + b[i] * v[1] + n[i] * v[2])
 }
 
 impl DiffuseLanes {

@@ -11,12 +11,13 @@ use crate::camera::camera_ray;
 use crate::cpu_scene::CpuScene;
 use crate::diffuse::DiffuseLanes;
 use crate::environment::{env_escape, has_env_map};
+use crate::glass::GlassLanes;
 use crate::intersect::Ray;
 use crate::light_sample::LightSample;
 use crate::lights::{choose_light, light_pdf, light_radiance, sample_light, sample_table_light};
 use crate::material::{
     eval_material, has_continuous_material_lobe, is_lambert, material_absorption, material_albedo,
-    material_at, sample_material,
+    material_at, rough_glass, sample_material,
 };
 use crate::microfacet::BsdfSample;
 use crate::sampler::{Draw, Sampler};
@@ -79,6 +80,26 @@ pub struct ShadowTest {
     pub t_max: f32,
     /// Radiance added to the path when nothing blocks the ray.
     pub radiance: Vec3A,
+}
+
+/// The vertices of a packet's paths whose shading waits to be computed side by side:
+/// [`Path::step`] leaves them here, the caller computes each kind and goes on with
+/// [`Path::leave_diffuse`] and [`Path::leave_glass`].
+#[derive(Debug, Clone, Default)]
+pub struct ShadingLanes {
+    /// Purely diffuse vertices.
+    pub diffuse: DiffuseLanes,
+    /// Rough glass vertices.
+    pub glass: GlassLanes,
+}
+
+impl ShadingLanes {
+    /// No lane waits.
+    #[inline(always)]
+    pub fn clear(&mut self) {
+        self.diffuse.clear();
+        self.glass.clear();
+    }
 }
 
 /// One camera path in progress, between its ray queries: [`Path::ray`] is to be traced and
@@ -150,16 +171,18 @@ impl Path {
     /// [`Path::add_unblocked`]) and the BSDF (the next ray), or ends the path. On a purely
     /// diffuse surface the rest of the bounce (the BSDF sample, and the light sample of a quad
     /// or a constant sky) is left to `diffuse` as lane `lane`: once
-    /// [`DiffuseLanes::compute`] ran, [`Path::leave_diffuse`] goes on.
+    /// [`DiffuseLanes::compute`] ran, [`Path::leave_diffuse`] goes on. On rough glass the BSDF
+    /// sample is left to `glass` likewise, and [`Path::leave_glass`] goes on.
     #[inline(always)]
     pub fn step(
         &mut self,
         scene: &CpuScene,
         params: &GpuRenderParams,
         hit: Option<Hit>,
-        diffuse: &mut DiffuseLanes,
+        lanes: &mut ShadingLanes,
         lane: usize,
     ) -> Option<ShadowTest> {
+        let ShadingLanes { diffuse, glass } = lanes;
         self.depth += 1;
         self.sample.rays += 1;
         let ray = self.ray;
@@ -288,9 +311,36 @@ impl Path {
             diffuse.push(lane, s.position, n, ng, wo, color, u_bsdf, u_rr);
             return shadow;
         }
+        if let Some(glass_params) = rough_glass(material)
+            && u_lobe < 1.0
+        {
+            let color = material.base_color;
+            let (position, ng) = (s.position, s.ng);
+            glass.push(
+                lane,
+                position,
+                s.ns,
+                ng,
+                wo,
+                color,
+                glass_params,
+                u_fresnel,
+                u_bsdf,
+                u_rr,
+            );
+            return shadow;
+        }
         let bs = sample_material(material, &s, wo, u_lobe, u_fresnel, u_bsdf);
         self.bounce(params, &bs, s.position, s.ng, n, u_rr);
         shadow
+    }
+
+    /// Goes on from the rough glass vertex that lane `lane` of `glass` holds, once
+    /// [`GlassLanes::compute`] ran.
+    #[inline(always)]
+    pub fn leave_glass(&mut self, params: &GpuRenderParams, glass: &GlassLanes, lane: usize) {
+        let v = glass.vertex(lane);
+        self.bounce(params, &v.sample, v.position, v.ng, v.n, v.u_rr);
     }
 
     /// Goes on from the diffuse vertex that lane `lane` of `diffuse` holds, once
@@ -381,14 +431,18 @@ pub fn trace_path(
     sampler: Sampler,
 ) -> PathSample {
     let mut path = Path::new(params, x, y, sampler);
-    let mut diffuse = DiffuseLanes::default();
+    let mut lanes = ShadingLanes::default();
     while path.alive {
         let hit = tracer.intersect(&path.ray, T_MAX);
-        diffuse.clear();
-        let mut shadow = path.step(scene, params, hit, &mut diffuse, 0);
-        if diffuse.mask != 0 {
-            diffuse.compute();
-            shadow = shadow.or(path.leave_diffuse(params, &diffuse, 0));
+        lanes.clear();
+        let mut shadow = path.step(scene, params, hit, &mut lanes, 0);
+        if lanes.diffuse.mask != 0 {
+            lanes.diffuse.compute();
+            shadow = shadow.or(path.leave_diffuse(params, &lanes.diffuse, 0));
+        }
+        if lanes.glass.mask != 0 {
+            lanes.glass.compute();
+            path.leave_glass(params, &lanes.glass, 0);
         }
         if let Some(shadow) = shadow
             && !tracer.occluded(&shadow.ray, shadow.t_max)

@@ -73,6 +73,18 @@ impl LobesParams {
     pub fn is_lambert(&self) -> bool {
         self.specular_rate == 0.0 && self.refract_rate == 0.0
     }
+
+    /// Where rough transmission is the only lobe (weight 1), its inside index of refraction,
+    /// GGX alpha and tint: [`crate::glass`] samples it.
+    #[inline(always)]
+    pub fn rough_glass(&self) -> Option<[f32; 3]> {
+        let alpha = self.refract_roughness * self.refract_roughness;
+        (self.specular_rate == 0.0 && self.refract_rate == 1.0 && alpha >= ALPHA_MIN).then_some([
+            self.ior,
+            alpha,
+            self.refract_tint,
+        ])
+    }
 }
 
 /// Reflectance of the specular lobe at `cos_i`. Twin of WGSL `specular_reflectance`.

@@ -168,6 +168,16 @@ pub fn is_lambert(p: &MaterialPoint) -> bool {
     p.model != MODEL_METAL_ROUGH && LobesParams::decode(&p.params).is_lambert()
 }
 
+/// Where the material is rough glass alone (the lobes model with its rough transmission lobe
+/// alone, [`LobesParams::rough_glass`]), its inside index of refraction, GGX alpha and tint.
+#[inline(always)]
+pub fn rough_glass(p: &MaterialPoint) -> Option<[f32; 3]> {
+    if p.model == MODEL_METAL_ROUGH {
+        return None;
+    }
+    LobesParams::decode(&p.params).rough_glass()
+}
+
 /// Whether the BSDF has a non-delta lobe (next-event estimation is worth doing). Twin of
 /// WGSL `has_continuous_material_lobe`.
 #[inline(always)]

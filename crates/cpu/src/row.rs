@@ -8,8 +8,7 @@ use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams};
 
 use crate::camera::{film_point, lens_ray, primary_directions};
 use crate::cpu_scene::CpuScene;
-use crate::diffuse::DiffuseLanes;
-use crate::integrator::{Path, T_MAX, accumulated_value, add_aov_sample, add_sample};
+use crate::integrator::{Path, ShadingLanes, T_MAX, accumulated_value, add_aov_sample, add_sample};
 use crate::intersect::Ray;
 use crate::packet::{Lanes, PACKET, RayPacket};
 use crate::sampler::Sampler;
@@ -73,7 +72,7 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
         ..RayPacket::default()
     };
     let mut shadows = RayPacket::default();
-    let mut diffuse = DiffuseLanes::default();
+    let mut shading = ShadingLanes::default();
     loop {
         packet.active = 0;
         for (l, lane) in lanes.iter().enumerate() {
@@ -89,10 +88,10 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
         let hits = tracer.intersect_packet(&packet);
         shadows.active = 0;
         let mut unblocked = [Vec3A::ZERO; PACKET];
-        diffuse.clear();
+        shading.clear();
         for (l, lane) in lanes.iter_mut().enumerate() {
             if let Some((_, path)) = lane
-                && let Some(shadow) = path.step(scene, params, hits.hit(l), &mut diffuse, l)
+                && let Some(shadow) = path.step(scene, params, hits.hit(l), &mut shading, l)
             {
                 shadows.rays[l] = shadow.ray;
                 shadows.t_max[l] = shadow.t_max;
@@ -100,6 +99,7 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
                 unblocked[l] = shadow.radiance;
             }
         }
+        let diffuse = &mut shading.diffuse;
         if diffuse.mask != 0 {
             diffuse.compute();
             let mut left = diffuse.mask;
@@ -107,12 +107,24 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
                 let l = left.trailing_zeros() as usize;
                 left &= left - 1;
                 if let Some((_, path)) = &mut lanes[l]
-                    && let Some(shadow) = path.leave_diffuse(params, &diffuse, l)
+                    && let Some(shadow) = path.leave_diffuse(params, diffuse, l)
                 {
                     shadows.rays[l] = shadow.ray;
                     shadows.t_max[l] = shadow.t_max;
                     shadows.active |= 1 << l;
                     unblocked[l] = shadow.radiance;
+                }
+            }
+        }
+        let glass = &mut shading.glass;
+        if glass.mask != 0 {
+            glass.compute();
+            let mut left = glass.mask;
+            while left != 0 {
+                let l = left.trailing_zeros() as usize;
+                left &= left - 1;
+                if let Some((_, path)) = &mut lanes[l] {
+                    path.leave_glass(params, glass, l);
                 }
             }
         }
