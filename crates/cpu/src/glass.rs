@@ -1,161 +1,65 @@
-//! The BSDF samples of the lanes of a packet whose paths stand on rough glass (the lobes
-//! model with its rough transmission lobe alone), computed side by side: the visible GGX
-//! normal, the Fresnel choice between its reflection and refraction, and the mixture's
-//! evaluation there (`eval_rough_dielectric`, read twice over for its density), the
-//! longest chain of dependent square roots and divisions of any bounce. Written as a loop
-//! over the lanes that the compiler turns into SIMD instructions, in place of that chain
-//! per path. The values are the one-path functions' bit for bit (`sample_lobes` through
-//! `rough_dielectric_direction`, `eval_lobes` and `continuous_sample`): the same operations
-//! in the same order, the early returns turned into a validity mask, and a test holds each
-//! lane to `sample_lobes`. CPU only (on the GPU, threads are lanes already).
+//! The BSDF samples of paths on rough glass (the lobes model with its rough transmission
+//! lobe alone) for [`SampleLanes`]: the visible GGX normal, the Fresnel choice between its
+//! reflection and refraction, and the mixture's evaluation there (`eval_rough_dielectric`,
+//! read twice over for its density), the longest chain of dependent square roots and
+//! divisions of any bounce. The values are the one-path functions' bit for bit
+//! (`sample_lobes` through `rough_dielectric_direction`, `eval_lobes` and
+//! `continuous_sample`), and a test holds each lane to `sample_lobes`.
 
-use std::f32::consts::PI;
-
-use glam::{Vec2, Vec3A};
-
-use crate::microfacet::{BsdfSample, INVALID, fresnel_dielectric_local};
-use crate::packet::{Lanes, PACKET};
-use crate::sampling::sin_cos_turns;
+use crate::bsdf_lanes::{LaneBsdf, LaneSample, LaneVertex, SampleLanes};
+use crate::lobes::LobesParams;
+use crate::microfacet::fresnel_dielectric_local;
+use crate::packet::PACKET;
 use crate::soa::{
-    Lanes3, add, at, cross, dot, frame_around, lane, normalize, scale, set_lane, to_local, to_world,
+    add, dot, frame_around, ggx_d, ggx_g1, ggx_sample_visible, normalize, scale, to_local, to_world,
 };
 
-/// A rough glass vertex with its BSDF sample, and what the path needs to go on from it.
-#[derive(Debug, Clone, Copy)]
-pub struct GlassVertex {
-    /// The BSDF sample.
-    pub sample: BsdfSample,
-    /// The vertex.
-    pub position: Vec3A,
-    /// Its geometric normal (on the shape's front side).
-    pub ng: Vec3A,
-    /// Its shading normal on the side of `wo`.
-    pub n: Vec3A,
-    /// The dimension deciding Russian roulette there.
-    pub u_rr: f32,
-}
+/// Rough glass lanes waiting for their BSDF samples.
+pub type GlassLanes = SampleLanes<RoughGlass>;
 
-/// Per lane, a rough glass vertex waiting for its BSDF sample ([`GlassLanes::push`]), and
-/// after [`GlassLanes::compute`] its results ([`GlassLanes::vertex`]).
+/// Per lane, rough glass's inside index of refraction, GGX alpha and the transmission's tint.
 #[derive(Debug, Clone)]
-pub struct GlassLanes {
-    /// Bit `l` set: lane `l` waits (or, after `compute`, has its results).
-    pub mask: Lanes,
-    // Inputs.
-    position: Lanes3,
-    /// The shading and geometric normals on the shape's front side.
-    ns: Lanes3,
-    ng: Lanes3,
-    wo: Lanes3,
-    color: Lanes3,
-    /// The inside's index of refraction, the GGX alpha, the transmission's tint.
+pub struct RoughGlass {
     ior: [f32; PACKET],
     alpha: [f32; PACKET],
     tint: [f32; PACKET],
-    /// The dimensions of the Fresnel choice, of the normal, and of Russian roulette.
-    u_fresnel: [f32; PACKET],
-    u: [[f32; PACKET]; 2],
-    u_rr: [f32; PACKET],
-    // Outputs.
-    wi: Lanes3,
-    weight: Lanes3,
-    pdf: [f32; PACKET],
-    eta: [f32; PACKET],
-    valid: [bool; PACKET],
 }
 
-impl Default for GlassLanes {
+impl Default for RoughGlass {
     fn default() -> Self {
-        let zero = [[0.0; PACKET]; 3];
         Self {
-            mask: 0,
-            position: zero,
-            ns: zero,
-            ng: zero,
-            wo: zero,
-            color: zero,
             ior: [1.0; PACKET],
             alpha: [1.0; PACKET],
             tint: [0.0; PACKET],
-            u_fresnel: [0.0; PACKET],
-            u: [[0.0; PACKET]; 2],
-            u_rr: [0.0; PACKET],
-            wi: zero,
-            weight: zero,
-            pdf: [0.0; PACKET],
-            eta: [1.0; PACKET],
-            valid: [false; PACKET],
         }
     }
 }
 
-/// What one lane's sample gives.
-struct LaneSample {
-    valid: bool,
-    wi: [f32; 3],
-    weight: [f32; 3],
-    pdf: f32,
-    eta: f32,
-}
+impl LaneBsdf for RoughGlass {
+    #[inline(always)]
+    fn set(&mut self, l: usize, m: &LobesParams) {
+        let alpha = m.refract_roughness * m.refract_roughness;
+        (self.ior[l], self.alpha[l], self.tint[l]) = (m.ior, alpha, m.refract_tint);
+    }
 
-/// `ggx_d`.
-#[inline(always)]
-fn ggx_d(m: [f32; 3], alpha: f32) -> f32 {
-    let a2 = alpha * alpha;
-    let t = (m[0] * m[0] + m[1] * m[1]) / a2 + m[2] * m[2];
-    1.0 / (PI * a2 * t * t)
-}
-
-/// `ggx_g1`.
-#[inline(always)]
-fn ggx_g1(w: [f32; 3], alpha: f32) -> f32 {
-    let z2 = w[2] * w[2];
-    let tan2 = (w[0] * w[0] + w[1] * w[1]) / z2;
-    let g1 = 2.0 / (1.0 + (1.0 + alpha * alpha * tan2).sqrt());
-    if z2 <= 0.0 { 0.0 } else { g1 }
-}
-
-/// `ggx_sample_visible`.
-#[inline(always)]
-fn ggx_sample_visible(wo: [f32; 3], alpha: f32, u: [f32; 2]) -> [f32; 3] {
-    let w = if wo[2] < 0.0 { wo.map(|c| -c) } else { wo };
-    let vh = normalize([alpha * w[0], alpha * w[1], w[2]]);
-    let len2 = vh[0] * vh[0] + vh[1] * vh[1];
-    let length = len2.sqrt();
-    let t1 = if len2 > 0.0 {
-        [-vh[1] / length, vh[0] / length, 0.0 / length]
-    } else {
-        [1.0, 0.0, 0.0]
-    };
-    let t2 = cross(vh, t1);
-    let r = u[0].sqrt();
-    let (sin, cos) = sin_cos_turns(u[1]);
-    let p1 = r * cos;
-    let s = 0.5 * (1.0 + vh[2]);
-    let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sin;
-    let k = (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
-    let nh = add(add(scale(p1, t1), scale(p2, t2)), scale(k, vh));
-    normalize([alpha * nh[0], alpha * nh[1], nh[2].max(1e-7)])
+    #[inline(always)]
+    fn sample(&self, l: usize, v: &LaneVertex) -> LaneSample {
+        sample_lane(v, self.ior[l], self.alpha[l], self.tint[l])
+    }
 }
 
 /// `sample_lobes` of rough glass alone: `rough_dielectric_direction`, then `eval_lobes`
 /// (`eval_rough_dielectric` with weight 1) and `continuous_sample` at the direction.
 #[inline(always)]
-#[expect(
-    clippy::too_many_arguments,
-    reason = "one lane's vertex, field by field"
-)]
-fn sample_lane(
-    ns: [f32; 3],
-    ng: [f32; 3],
-    wo: [f32; 3],
-    color: [f32; 3],
-    ior: f32,
-    alpha: f32,
-    tint: f32,
-    u_fresnel: f32,
-    u: [f32; 2],
-) -> LaneSample {
+fn sample_lane(v: &LaneVertex, ior: f32, alpha: f32, tint: f32) -> LaneSample {
+    let LaneVertex {
+        ns,
+        ng,
+        wo,
+        color,
+        u_fresnel,
+        u,
+    } = *v;
     // `rough_dielectric_direction`.
     let frame = frame_around(ns);
     let wo_l = to_local(&frame, wo);
@@ -232,118 +136,12 @@ fn sample_lane(
     }
 }
 
-impl GlassLanes {
-    /// No lane waits.
-    #[inline(always)]
-    pub fn clear(&mut self) {
-        self.mask = 0;
-    }
-
-    /// Lane `l` waits at `position`, on rough glass of inside index `ior`, GGX `alpha` and
-    /// transmission tinted by `tint` towards `color`, with shading normal `ns` and
-    /// geometric normal `ng` (both on the shape's front side), seen from `wo`, with the
-    /// dimensions of its Fresnel choice (`u_fresnel`), of its normal (`u`) and of Russian
-    /// roulette (`u_rr`).
-    #[inline(always)]
-    #[expect(
-        clippy::too_many_arguments,
-        reason = "one lane's vertex, field by field"
-    )]
-    pub fn push(
-        &mut self,
-        l: usize,
-        position: Vec3A,
-        ns: Vec3A,
-        ng: Vec3A,
-        wo: Vec3A,
-        color: Vec3A,
-        [ior, alpha, tint]: [f32; 3],
-        u_fresnel: f32,
-        u: Vec2,
-        u_rr: f32,
-    ) {
-        set_lane(&mut self.position, l, position);
-        set_lane(&mut self.ns, l, ns);
-        set_lane(&mut self.ng, l, ng);
-        set_lane(&mut self.wo, l, wo);
-        set_lane(&mut self.color, l, color);
-        (self.ior[l], self.alpha[l], self.tint[l]) = (ior, alpha, tint);
-        self.u_fresnel[l] = u_fresnel;
-        self.u[0][l] = u.x;
-        self.u[1][l] = u.y;
-        self.u_rr[l] = u_rr;
-        self.mask |= 1 << l;
-    }
-
-    /// Computes every lane side by side (those not waiting compute throw-away values: a
-    /// packet holds a few rough glass lanes, but computing only theirs, gathered into as few
-    /// AVX-512 registers as they fill, was slower).
-    #[inline(always)]
-    pub fn compute(&mut self) {
-        for l in 0..PACKET {
-            self.compute_lane(l);
-        }
-    }
-
-    /// Computes lane `l`.
-    #[inline(always)]
-    fn compute_lane(&mut self, l: usize) {
-        let s = sample_lane(
-            at(&self.ns, l),
-            at(&self.ng, l),
-            at(&self.wo, l),
-            at(&self.color, l),
-            self.ior[l],
-            self.alpha[l],
-            self.tint[l],
-            self.u_fresnel[l],
-            [self.u[0][l], self.u[1][l]],
-        );
-        self.valid[l] = s.valid;
-        for axis in 0..3 {
-            self.wi[axis][l] = s.wi[axis];
-            self.weight[axis][l] = s.weight[axis];
-        }
-        self.pdf[l] = s.pdf;
-        self.eta[l] = s.eta;
-    }
-
-    /// Lane `l`'s results, once [`GlassLanes::compute`] ran.
-    #[inline(always)]
-    pub fn vertex(&self, l: usize) -> GlassVertex {
-        let sample = if self.valid[l] {
-            BsdfSample {
-                wi: lane(&self.wi, l),
-                weight: lane(&self.weight, l),
-                pdf: self.pdf[l],
-                delta: false,
-                eta: self.eta[l],
-                valid: true,
-            }
-        } else {
-            INVALID
-        };
-        let (ns, ng) = (lane(&self.ns, l), lane(&self.ng, l));
-        GlassVertex {
-            sample,
-            position: lane(&self.position, l),
-            ng,
-            n: if lane(&self.wo, l).dot(ng) >= 0.0 {
-                ns
-            } else {
-                -ns
-            },
-            u_rr: self.u_rr[l],
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
-    use glam::Vec4;
+    use glam::{Vec2, Vec3A, Vec4};
 
     use super::*;
-    use crate::lobes::{LobesParams, sample_lobes};
+    use crate::lobes::sample_lobes;
     use crate::material::MODEL_PARAMS;
     use crate::surface::Surface;
 
@@ -409,12 +207,9 @@ mod tests {
                     material: 0,
                     color: Vec3A::ONE,
                 };
-                let alpha = roughness * roughness;
-                let params = [ior, alpha, tint];
+                assert!(m.is_rough_glass());
                 let lane = (l * 7 + round) % PACKET;
-                lanes.push(
-                    lane, s.position, ns, ng, wo, color, params, u_fresnel, u, 0.5,
-                );
+                lanes.push(lane, s.position, ns, ng, wo, color, m, (u_fresnel, u, 0.5));
                 cases.push(sample_lobes(&m, color, &s, wo, 0.5, u_fresnel, u));
             }
             lanes.compute();

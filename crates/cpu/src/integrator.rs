@@ -6,18 +6,20 @@ use pathlight_core::gpu_types::{
     GpuAccumPixel, GpuAovPixel, GpuRenderParams, KIND_QUAD, LIGHT_AREA, NO_LIGHT,
 };
 
+use crate::bsdf_lanes::{LaneBsdf, SampleLanes};
 use crate::bvh::Hit;
 use crate::camera::camera_ray;
 use crate::cpu_scene::CpuScene;
 use crate::diffuse::DiffuseLanes;
 use crate::environment::{env_escape, has_env_map};
 use crate::glass::GlassLanes;
+use crate::glossy::GlossyLanes;
 use crate::intersect::Ray;
 use crate::light_sample::LightSample;
 use crate::lights::{choose_light, light_pdf, light_radiance, sample_light, sample_table_light};
 use crate::material::{
-    eval_material, has_continuous_material_lobe, is_lambert, material_absorption, material_albedo,
-    material_at, rough_glass, sample_material,
+    eval_material, has_continuous_material_lobe, is_lambert, lobes_params, material_absorption,
+    material_albedo, material_at, sample_material,
 };
 use crate::microfacet::BsdfSample;
 use crate::sampler::{Draw, Sampler};
@@ -82,15 +84,18 @@ pub struct ShadowTest {
     pub radiance: Vec3A,
 }
 
-/// The vertices of a packet's paths whose shading waits to be computed side by side:
+/// The vertices of a packet's paths whose shading waits to be computed side by side, by
+/// kind of material:
 /// [`Path::step`] leaves them here, the caller computes each kind and goes on with
-/// [`Path::leave_diffuse`] and [`Path::leave_glass`].
+/// [`Path::leave_diffuse`] and [`Path::leave_sampled`].
 #[derive(Debug, Clone, Default)]
 pub struct ShadingLanes {
     /// Purely diffuse vertices.
     pub diffuse: DiffuseLanes,
-    /// Rough glass vertices.
+    /// Rough glass vertices (the lobes model's rough transmission alone).
     pub glass: GlassLanes,
+    /// Rough mirror vertices (the lobes model's rough specular reflection alone).
+    pub glossy: GlossyLanes,
 }
 
 impl ShadingLanes {
@@ -99,6 +104,7 @@ impl ShadingLanes {
     pub fn clear(&mut self) {
         self.diffuse.clear();
         self.glass.clear();
+        self.glossy.clear();
     }
 }
 
@@ -171,8 +177,9 @@ impl Path {
     /// [`Path::add_unblocked`]) and the BSDF (the next ray), or ends the path. On a purely
     /// diffuse surface the rest of the bounce (the BSDF sample, and the light sample of a quad
     /// or a constant sky) is left to `diffuse` as lane `lane`: once
-    /// [`DiffuseLanes::compute`] ran, [`Path::leave_diffuse`] goes on. On rough glass the BSDF
-    /// sample is left to `glass` likewise, and [`Path::leave_glass`] goes on.
+    /// [`DiffuseLanes::compute`] ran, [`Path::leave_diffuse`] goes on. On rough glass or a
+    /// rough mirror the BSDF sample is left to `glass` or `glossy` likewise, and
+    /// [`Path::leave_sampled`] goes on.
     #[inline(always)]
     pub fn step(
         &mut self,
@@ -182,7 +189,11 @@ impl Path {
         lanes: &mut ShadingLanes,
         lane: usize,
     ) -> Option<ShadowTest> {
-        let ShadingLanes { diffuse, glass } = lanes;
+        let ShadingLanes {
+            diffuse,
+            glass,
+            glossy,
+        } = lanes;
         self.depth += 1;
         self.sample.rays += 1;
         let ray = self.ray;
@@ -311,35 +322,37 @@ impl Path {
             diffuse.push(lane, s.position, n, ng, wo, color, u_bsdf, u_rr);
             return shadow;
         }
-        if let Some(glass_params) = rough_glass(material)
+        // Rough glass or a rough mirror alone: the lobe is the mixture's only one (u_lobe
+        // below its weight, 1).
+        if let Some(m) = lobes_params(material)
             && u_lobe < 1.0
         {
-            let color = material.base_color;
-            let (position, ng) = (s.position, s.ng);
-            glass.push(
-                lane,
-                position,
-                s.ns,
-                ng,
-                wo,
-                color,
-                glass_params,
-                u_fresnel,
-                u_bsdf,
-                u_rr,
-            );
-            return shadow;
+            let (position, ng, color) = (s.position, s.ng, material.base_color);
+            let u = (u_fresnel, u_bsdf, u_rr);
+            if m.is_rough_glass() {
+                glass.push(lane, position, s.ns, ng, wo, color, m, u);
+                return shadow;
+            }
+            if m.is_rough_mirror() {
+                glossy.push(lane, position, s.ns, ng, wo, color, m, u);
+                return shadow;
+            }
         }
         let bs = sample_material(material, &s, wo, u_lobe, u_fresnel, u_bsdf);
         self.bounce(params, &bs, s.position, s.ng, n, u_rr);
         shadow
     }
 
-    /// Goes on from the rough glass vertex that lane `lane` of `glass` holds, once
-    /// [`GlassLanes::compute`] ran.
+    /// Goes on from the vertex that lane `lane` of `lanes` holds, once
+    /// [`SampleLanes::compute`] ran.
     #[inline(always)]
-    pub fn leave_glass(&mut self, params: &GpuRenderParams, glass: &GlassLanes, lane: usize) {
-        let v = glass.vertex(lane);
+    pub fn leave_sampled<M: LaneBsdf>(
+        &mut self,
+        params: &GpuRenderParams,
+        lanes: &SampleLanes<M>,
+        lane: usize,
+    ) {
+        let v = lanes.vertex(lane);
         self.bounce(params, &v.sample, v.position, v.ng, v.n, v.u_rr);
     }
 
@@ -442,7 +455,11 @@ pub fn trace_path(
         }
         if lanes.glass.mask != 0 {
             lanes.glass.compute();
-            path.leave_glass(params, &lanes.glass, 0);
+            path.leave_sampled(params, &lanes.glass, 0);
+        }
+        if lanes.glossy.mask != 0 {
+            lanes.glossy.compute();
+            path.leave_sampled(params, &lanes.glossy, 0);
         }
         if let Some(shadow) = shadow
             && !tracer.occluded(&shadow.ray, shadow.t_max)

@@ -6,6 +6,7 @@
 //! render scenes on both backends and compare.
 
 pub mod area_light;
+pub mod bsdf_lanes;
 pub mod bvh;
 pub mod camera;
 pub mod cpu_scene;
@@ -13,6 +14,7 @@ pub mod diffuse;
 pub mod display;
 pub mod environment;
 pub mod glass;
+pub mod glossy;
 pub mod integrator;
 pub mod intersect;
 pub mod light_sample;

@@ -74,16 +74,19 @@ impl LobesParams {
         self.specular_rate == 0.0 && self.refract_rate == 0.0
     }
 
-    /// Where rough transmission is the only lobe (weight 1), its inside index of refraction,
-    /// GGX alpha and tint: [`crate::glass`] samples it.
+    /// Whether rough transmission is the only lobe (weight 1): [`crate::glass`] samples it.
     #[inline(always)]
-    pub fn rough_glass(&self) -> Option<[f32; 3]> {
+    pub fn is_rough_glass(&self) -> bool {
         let alpha = self.refract_roughness * self.refract_roughness;
-        (self.specular_rate == 0.0 && self.refract_rate == 1.0 && alpha >= ALPHA_MIN).then_some([
-            self.ior,
-            alpha,
-            self.refract_tint,
-        ])
+        self.specular_rate == 0.0 && self.refract_rate == 1.0 && alpha >= ALPHA_MIN
+    }
+
+    /// Whether rough specular reflection is the only lobe (weight 1): [`crate::glossy`]
+    /// samples it.
+    #[inline(always)]
+    pub fn is_rough_mirror(&self) -> bool {
+        let alpha = self.specular_roughness * self.specular_roughness;
+        self.specular_rate == 1.0 && self.refract_rate == 0.0 && alpha >= ALPHA_MIN
     }
 }
 

@@ -168,14 +168,10 @@ pub fn is_lambert(p: &MaterialPoint) -> bool {
     p.model != MODEL_METAL_ROUGH && LobesParams::decode(&p.params).is_lambert()
 }
 
-/// Where the material is rough glass alone (the lobes model with its rough transmission lobe
-/// alone, [`LobesParams::rough_glass`]), its inside index of refraction, GGX alpha and tint.
+/// The parameters of a material of the lobes model.
 #[inline(always)]
-pub fn rough_glass(p: &MaterialPoint) -> Option<[f32; 3]> {
-    if p.model == MODEL_METAL_ROUGH {
-        return None;
-    }
-    LobesParams::decode(&p.params).rough_glass()
+pub fn lobes_params(p: &MaterialPoint) -> Option<LobesParams> {
+    (p.model != MODEL_METAL_ROUGH).then(|| LobesParams::decode(&p.params))
 }
 
 /// Whether the BSDF has a non-delta lobe (next-event estimation is worth doing). Twin of

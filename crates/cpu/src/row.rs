@@ -6,6 +6,7 @@ use std::ops::Range;
 use glam::{Vec3, Vec3A};
 use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams};
 
+use crate::bsdf_lanes::{LaneBsdf, SampleLanes};
 use crate::camera::{film_point, lens_ray, primary_directions};
 use crate::cpu_scene::CpuScene;
 use crate::integrator::{Path, ShadingLanes, T_MAX, accumulated_value, add_aov_sample, add_sample};
@@ -116,18 +117,8 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
                 }
             }
         }
-        let glass = &mut shading.glass;
-        if glass.mask != 0 {
-            glass.compute();
-            let mut left = glass.mask;
-            while left != 0 {
-                let l = left.trailing_zeros() as usize;
-                left &= left - 1;
-                if let Some((_, path)) = &mut lanes[l] {
-                    path.leave_glass(params, glass, l);
-                }
-            }
-        }
+        leave_sampled(&mut lanes, &mut shading.glass, params);
+        leave_sampled(&mut lanes, &mut shading.glossy, params);
         let blocked = tracer.occluded_packet(&shadows);
         for (l, lane) in lanes.iter_mut().enumerate() {
             let Some((x, path)) = lane else { continue };
@@ -138,6 +129,28 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
                 tally = tally + finish(path, row, *x);
                 *lane = None;
             }
+        }
+    }
+}
+
+/// Computes the BSDF samples that `waiting` holds for paths of `lanes`, and goes on with
+/// those paths.
+#[inline(always)]
+fn leave_sampled<M: LaneBsdf>(
+    lanes: &mut [Option<(usize, Path)>; PACKET],
+    waiting: &mut SampleLanes<M>,
+    params: &GpuRenderParams,
+) {
+    if waiting.mask == 0 {
+        return;
+    }
+    waiting.compute();
+    let mut left = waiting.mask;
+    while left != 0 {
+        let l = left.trailing_zeros() as usize;
+        left &= left - 1;
+        if let Some((_, path)) = &mut lanes[l] {
+            path.leave_sampled(params, waiting, l);
         }
     }
 }
