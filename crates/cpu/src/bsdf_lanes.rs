@@ -166,7 +166,7 @@ impl<M: LaneBsdf> SampleLanes<M> {
         self.mask |= 1 << l;
     }
 
-    /// Computes the waiting lanes: up to [`ONE_BY_ONE`] of them one after another, more
+    /// Computes the waiting lanes: up to `ONE_BY_ONE` of them one after another, more
     /// every lane side by side (those not waiting compute throw-away values; computing only
     /// theirs, gathered into as few AVX-512 registers as they fill, was slower).
     #[inline(always)]

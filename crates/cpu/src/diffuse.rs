@@ -8,7 +8,7 @@
 //! (`sample_lobes`, `sample_area_light`, `sample_environment`, `eval_lobes`,
 //! `power_heuristic`, `shadow_ray`): the same operations in the same order. Scalar helpers
 //! are called as they are (`sin_cos_turns`, `power_heuristic`); those written on glam's
-//! `Vec3A` are written again on `[f32; 3]` (`Frame` and the dot product in [`crate::soa`],
+//! `Vec3A` are written again on `[f32; 3]` (`Frame` and the dot product in `soa.rs`,
 //! `sample_cosine_hemisphere` here), as the packet code keeps its lanes in plain arrays, and
 //! the tests hold each copy to its original. CPU only (on the GPU, threads are lanes
 //! already).
