@@ -178,8 +178,8 @@ impl Path {
     /// diffuse surface the rest of the bounce (the BSDF sample, and the light sample of a quad
     /// or a constant sky) is left to `diffuse` as lane `lane`: once
     /// [`DiffuseLanes::compute`] ran, [`Path::leave_diffuse`] goes on. On rough glass or a
-    /// rough mirror the BSDF sample is left to `glass` or `glossy` likewise, and
-    /// [`Path::leave_sampled`] goes on.
+    /// rough mirror (where `mirror_lanes`) the BSDF sample is left to `glass` or `glossy`
+    /// likewise, and [`Path::leave_sampled`] goes on.
     #[inline(always)]
     pub fn step(
         &mut self,
@@ -188,6 +188,7 @@ impl Path {
         hit: Option<Hit>,
         lanes: &mut ShadingLanes,
         lane: usize,
+        mirror_lanes: bool,
     ) -> Option<ShadowTest> {
         let ShadingLanes {
             diffuse,
@@ -333,7 +334,7 @@ impl Path {
                 glass.push(lane, position, s.ns, ng, wo, color, m, u);
                 return shadow;
             }
-            if m.is_rough_mirror() {
+            if mirror_lanes && m.is_rough_mirror() {
                 glossy.push(lane, position, s.ns, ng, wo, color, m, u);
                 return shadow;
             }
@@ -448,7 +449,7 @@ pub fn trace_path(
     while path.alive {
         let hit = tracer.intersect(&path.ray, T_MAX);
         lanes.clear();
-        let mut shadow = path.step(scene, params, hit, &mut lanes, 0);
+        let mut shadow = path.step(scene, params, hit, &mut lanes, 0, true);
         if lanes.diffuse.mask != 0 {
             lanes.diffuse.compute();
             shadow = shadow.or(path.leave_diffuse(params, &lanes.diffuse, 0));

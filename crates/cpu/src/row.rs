@@ -60,9 +60,14 @@ impl std::iter::Sum for Tally {
 /// (pixel by pixel, each pixel's in turn) are traced as paths side by side, [`PACKET`] at a
 /// time, their rays traced together as packets; a path that ends hands its lane to the next
 /// sample. The whole path tracer is inlined here, so that each [`InstructionSet`] level
-/// compiles all of it.
+/// compiles all of it. `MIRROR_LANES`: rough mirrors' BSDF samples side by side (at the
+/// AVX-512 level; with AVX2's 8 lanes a register they cost cornell-materials 3-4%).
 #[inline(always)]
-fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
+fn render_row<const MIRROR_LANES: bool>(
+    tracer: &mut Tracer,
+    job: &RowJob,
+    row: &mut RowSums,
+) -> Tally {
     let (scene, params) = (job.scene, job.params);
     let mut starter = Starter::new(job, row.color.len());
     let mut lanes: [Option<(usize, Path)>; PACKET] = std::array::from_fn(|_| None);
@@ -92,7 +97,8 @@ fn render_row(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
         shading.clear();
         for (l, lane) in lanes.iter_mut().enumerate() {
             if let Some((_, path)) = lane
-                && let Some(shadow) = path.step(scene, params, hits.hit(l), &mut shading, l)
+                && let Some(shadow) =
+                    path.step(scene, params, hits.hit(l), &mut shading, l, MIRROR_LANES)
             {
                 shadows.rays[l] = shadow.ray;
                 shadows.t_max[l] = shadow.t_max;
@@ -377,7 +383,7 @@ pub(crate) fn render_row_with(
     row: &mut RowSums,
 ) -> Tally {
     match isa {
-        InstructionSet::Baseline => render_row(tracer, job, row),
+        InstructionSet::Baseline => render_row::<false>(tracer, job, row),
         // SAFETY: `InstructionSet::supported` found the features on this CPU.
         #[cfg(target_arch = "x86_64")]
         InstructionSet::X86_64V3 => unsafe { render_row_x86_64_v3(tracer, job, row) },
@@ -391,7 +397,7 @@ pub(crate) fn render_row_with(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe")]
 fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
-    render_row(tracer, job, row)
+    render_row::<false>(tracer, job, row)
 }
 
 /// [`render_row`] for x86-64-v4 with GFNI.
@@ -400,5 +406,5 @@ fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) ->
     enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe,avx512f,avx512vl,avx512bw,avx512dq,avx512cd,gfni"
 )]
 fn render_row_x86_64_v4_gfni(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
-    render_row(tracer, job, row)
+    render_row::<true>(tracer, job, row)
 }
