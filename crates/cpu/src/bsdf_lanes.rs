@@ -235,3 +235,92 @@ impl<M: LaneBsdf> SampleLanes<M> {
         }
     }
 }
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::lobes::sample_lobes;
+    use crate::surface::Surface;
+
+    /// Uniform numbers in [0, 1) (xorshift from `state`).
+    pub(crate) fn uniform(mut state: u32) -> impl FnMut() -> f32 {
+        move || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state as f32 / 4_294_967_296.0
+        }
+    }
+
+    /// A unit vector from three uniform numbers in [-1, 1) (not uniform on the sphere).
+    fn unit(next: &mut dyn FnMut() -> f32) -> Vec3A {
+        (Vec3A::new(next(), next(), next()) * 2.0 - 1.0).normalize()
+    }
+
+    /// Checks that lanes of kind `M` compute `sample_lobes`'s samples bit for bit, over 512
+    /// packets from one lane waiting to all, in any order: materials from `material` (given
+    /// the lane and the random numbers), random geometric normals, shading normals bent away
+    /// from them and next to -z (the frame's other branch), views from both sides, draws at
+    /// 0 and next to 1. Returns how many samples were invalid, and how many valid ones
+    /// `class` put in each of its two classes.
+    pub(crate) fn assert_lanes_as_sample_lobes<M: LaneBsdf>(
+        seed: u32,
+        mut material: impl FnMut(usize, &mut dyn FnMut() -> f32) -> LobesParams,
+        class: impl Fn(&BsdfSample, &LobesParams) -> bool,
+    ) -> [usize; 3] {
+        let mut next = uniform(seed);
+        let mut outcomes = [0; 3];
+        for round in 0..512 {
+            let mut lanes = SampleLanes::<M>::default();
+            let mut cases = Vec::new();
+            for l in 0..1 + round % PACKET {
+                let m = material(l, &mut next);
+                let ng = unit(&mut next);
+                let mut ns = (unit(&mut next) * 0.3 + ng).normalize();
+                if l % 8 == 0 {
+                    ns = Vec3A::new(0.01 * next(), -0.01 * next(), -1.0).normalize();
+                }
+                if ns.dot(ng) < 0.0 {
+                    ns = -ns;
+                }
+                let wo = unit(&mut next);
+                let mut u = Vec2::new(next(), next());
+                if round % 16 == 0 {
+                    u = Vec2::new([0.0, 1.0f32.next_down()][l % 2], [0.0, 0.999_999_9][l / 16]);
+                }
+                let u_fresnel = next();
+                let color = Vec3A::new(next(), next(), next());
+                let s = Surface {
+                    position: (Vec3A::new(next(), next(), next()) - 0.5) * 20.0,
+                    ng,
+                    ns,
+                    nc: ns,
+                    uv: Vec2::ZERO,
+                    material: 0,
+                    color: Vec3A::ONE,
+                };
+                let lane = (l * 7 + round) % PACKET;
+                lanes.push(lane, s.position, ns, ng, wo, color, m, (u_fresnel, u, 0.5));
+                cases.push((m, sample_lobes(&m, color, &s, wo, 0.5, u_fresnel, u)));
+            }
+            lanes.compute();
+            assert_eq!(lanes.mask.count_ones() as usize, cases.len());
+            for (l, (m, theirs)) in cases.iter().enumerate() {
+                let ours = lanes.vertex((l * 7 + round) % PACKET).sample;
+                let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
+                assert_eq!(ours.valid, theirs.valid, "lane {l}, round {round}");
+                if !ours.valid {
+                    outcomes[0] += 1;
+                    continue;
+                }
+                outcomes[1 + usize::from(class(&ours, m))] += 1;
+                assert_eq!(bits(ours.wi), bits(theirs.wi), "lane {l}, round {round}");
+                assert_eq!(bits(ours.weight), bits(theirs.weight), "lane {l}");
+                assert_eq!(ours.pdf.to_bits(), theirs.pdf.to_bits(), "lane {l}");
+                assert_eq!(ours.eta.to_bits(), theirs.eta.to_bits(), "lane {l}");
+                assert_eq!(ours.delta, theirs.delta);
+            }
+        }
+        outcomes
+    }
+}

@@ -405,6 +405,7 @@ mod tests {
     use pathlight_core::gpu_types::{GpuRenderParams, KIND_QUAD, LIGHT_AREA};
 
     use super::*;
+    use crate::bsdf_lanes::tests::uniform;
     use crate::integrator::shadow_ray;
     use crate::lights::{choose_light, light_radiance, sample_light, sample_table_light};
     use crate::lobes::{LobesParams, eval_lobes, sample_lobes};
@@ -414,16 +415,6 @@ mod tests {
     /// A unit vector from three uniform numbers in [-1, 1) (not uniform on the sphere).
     fn unit(v: impl Into<Vec3A>) -> Vec3A {
         v.into().normalize()
-    }
-
-    /// Uniform numbers in [0, 1) (xorshift from `seed`).
-    fn uniform(mut state: u32) -> impl FnMut() -> f32 {
-        move || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state as f32 / 4_294_967_296.0
-        }
     }
 
     /// The surface at `position` with geometric normal `ng` and shading normal `ns`.

@@ -138,44 +138,22 @@ fn sample_lane(v: &LaneVertex, ior: f32, alpha: f32, tint: f32) -> LaneSample {
 
 #[cfg(test)]
 mod tests {
-    use glam::{Vec2, Vec3A, Vec4};
+    use glam::Vec4;
 
     use super::*;
-    use crate::lobes::sample_lobes;
+    use crate::bsdf_lanes::tests::assert_lanes_as_sample_lobes;
     use crate::material::MODEL_PARAMS;
-    use crate::surface::Surface;
 
-    /// Uniform numbers in [0, 1) (xorshift from `seed`).
-    fn uniform(mut state: u32) -> impl FnMut() -> f32 {
-        move || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state as f32 / 4_294_967_296.0
-        }
-    }
-
-    /// Three uniform numbers in [-1, 1) drawn from `next`, normalised.
-    fn unit(next: &mut impl FnMut() -> f32) -> Vec3A {
-        (Vec3A::new(next(), next(), next()) * 2.0 - 1.0).normalize()
-    }
-
-    /// Every lane's sample is `sample_lobes`'s for rough glass alone bit for bit: indices
-    /// above and below 1 (thin films of air), roughnesses from nearly smooth to 1, tints,
-    /// both sides of the surface, shading normals bent away from the geometric one and
-    /// next to -z (the frame's other branch), Fresnel draws choosing each branch, total
-    /// internal reflection, draws at 0 and next to 1; from one lane waiting to all. It fails with any operation reordered
-    /// (a dot product summed in another order, a quotient taken as a product by the
-    /// reciprocal, the mixture's sum over its lobe left out).
+    /// Every lane's sample is `sample_lobes`'s for rough glass alone bit for bit
+    /// (`assert_lanes_as_sample_lobes`): indices above and below 1 (thin films of air),
+    /// roughnesses from nearly smooth to 1, tints, Fresnel draws choosing each branch, total
+    /// internal reflection. It fails with an operation regrouped (a quotient taken as a
+    /// product by the reciprocal, a density's factors grouped otherwise).
     #[test]
     fn lanes_sample_as_sample_lobes_bit_for_bit() {
-        let mut next = uniform(0x51ed_270b);
-        let mut outcomes = [0; 3];
-        for round in 0..512 {
-            let mut lanes = GlassLanes::default();
-            let mut cases = Vec::new();
-            // Any number of lanes waiting, in any order.
-            for l in 0..1 + round % PACKET {
+        let outcomes = assert_lanes_as_sample_lobes::<RoughGlass>(
+            0x51ed_270b,
+            |l, next| {
                 let mut block = [Vec4::ZERO; MODEL_PARAMS];
                 let ior = [1.5, 1.33, 0.75, 2.4][l % 4];
                 let roughness = 0.04 + 0.96 * next();
@@ -183,53 +161,11 @@ mod tests {
                 block[0].w = 1.0;
                 block[1] = Vec4::new(tint, ior, roughness, 0.0);
                 let m = LobesParams::decode(&block);
-                let ng = unit(&mut next);
-                let mut ns = (unit(&mut next) * 0.3 + ng).normalize();
-                if l % 8 == 0 {
-                    ns = Vec3A::new(0.01 * next(), -0.01 * next(), -1.0).normalize();
-                }
-                if ns.dot(ng) < 0.0 {
-                    ns = -ns;
-                }
-                let wo = unit(&mut next);
-                let mut u = Vec2::new(next(), next());
-                if round % 16 == 0 {
-                    u = Vec2::new([0.0, 1.0f32.next_down()][l % 2], [0.0, 0.999_999_9][l / 16]);
-                }
-                let u_fresnel = next();
-                let color = Vec3A::new(next(), next(), next());
-                let s = Surface {
-                    position: (Vec3A::new(next(), next(), next()) - 0.5) * 20.0,
-                    ng,
-                    ns,
-                    nc: ns,
-                    uv: Vec2::ZERO,
-                    material: 0,
-                    color: Vec3A::ONE,
-                };
                 assert!(m.is_rough_glass());
-                let lane = (l * 7 + round) % PACKET;
-                lanes.push(lane, s.position, ns, ng, wo, color, m, (u_fresnel, u, 0.5));
-                cases.push(sample_lobes(&m, color, &s, wo, 0.5, u_fresnel, u));
-            }
-            lanes.compute();
-            assert_eq!(lanes.mask.count_ones() as usize, cases.len());
-            for (l, theirs) in cases.iter().enumerate() {
-                let ours = lanes.vertex((l * 7 + round) % PACKET).sample;
-                let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
-                assert_eq!(ours.valid, theirs.valid, "lane {l}, round {round}");
-                if !ours.valid {
-                    outcomes[0] += 1;
-                    continue;
-                }
-                outcomes[1 + usize::from(ours.eta != 1.0)] += 1;
-                assert_eq!(bits(ours.wi), bits(theirs.wi), "lane {l}, round {round}");
-                assert_eq!(bits(ours.weight), bits(theirs.weight), "lane {l}");
-                assert_eq!(ours.pdf.to_bits(), theirs.pdf.to_bits(), "lane {l}");
-                assert_eq!(ours.eta.to_bits(), theirs.eta.to_bits(), "lane {l}");
-                assert_eq!(ours.delta, theirs.delta);
-            }
-        }
+                m
+            },
+            |sample, _| sample.eta != 1.0,
+        );
         // Invalid samples, reflections and refractions were all met often.
         assert!(outcomes.iter().all(|&n| n > 300), "{outcomes:?}");
     }

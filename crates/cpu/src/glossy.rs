@@ -160,43 +160,22 @@ fn sample_lane(v: &LaneVertex, alpha: f32, fresnel: &Fresnel) -> LaneSample {
 
 #[cfg(test)]
 mod tests {
-    use glam::{Vec2, Vec3A, Vec4};
+    use glam::{Vec3A, Vec4};
 
     use super::*;
-    use crate::lobes::sample_lobes;
+    use crate::bsdf_lanes::tests::assert_lanes_as_sample_lobes;
     use crate::material::MODEL_PARAMS;
-    use crate::surface::Surface;
 
-    /// Uniform numbers in [0, 1) (xorshift from `seed`).
-    fn uniform(mut state: u32) -> impl FnMut() -> f32 {
-        move || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state as f32 / 4_294_967_296.0
-        }
-    }
-
-    /// Three uniform numbers in [-1, 1) drawn from `next`, normalised.
-    fn unit(next: &mut impl FnMut() -> f32) -> Vec3A {
-        (Vec3A::new(next(), next(), next()) * 2.0 - 1.0).normalize()
-    }
-
-    /// Every lane's sample is `sample_lobes`'s for a rough mirror alone bit for bit:
-    /// conductors (gold, aluminium, an index with no absorption) and Schlick's Fresnel with
-    /// any tint, roughnesses from nearly smooth to 1, both sides of the surface, shading
-    /// normals bent away from the geometric one and next to -z (the frame's other branch),
-    /// draws at 0 and next to 1; from one lane waiting to all. It fails with any operation
-    /// reordered (a dot product summed in another order, the conductor's floors taken with
-    /// `f32::max`'s rule for signed zeros, the mixture's sum over its lobe left out).
+    /// Every lane's sample is `sample_lobes`'s for a rough mirror alone bit for bit
+    /// (`assert_lanes_as_sample_lobes`): conductors (gold, aluminium, an index with no
+    /// absorption) and Schlick's Fresnel with any tint, roughnesses from nearly smooth to 1.
+    /// It fails with any operation regrouped (a quotient taken before a product, the
+    /// conductor's `eta^2 - k^2 - sin^2` summed in another order).
     #[test]
     fn lanes_sample_as_sample_lobes_bit_for_bit() {
-        let mut next = uniform(0x3c6e_f372);
-        let mut outcomes = [0; 3];
-        for round in 0..512 {
-            let mut lanes = GlossyLanes::default();
-            let mut cases = Vec::new();
-            for l in 0..1 + round % PACKET {
+        let outcomes = assert_lanes_as_sample_lobes::<RoughMirror>(
+            0x3c6e_f372,
+            |l, next| {
                 let mut block = [Vec4::ZERO; MODEL_PARAMS];
                 let roughness = 0.04 + 0.96 * next();
                 let conductor = l % 4 != 3;
@@ -211,51 +190,10 @@ mod tests {
                 block[3] = Vec3A::from(k).extend(0.0);
                 let m = LobesParams::decode(&block);
                 assert!(m.is_rough_mirror());
-                let ng = unit(&mut next);
-                let mut ns = (unit(&mut next) * 0.3 + ng).normalize();
-                if l % 8 == 0 {
-                    ns = Vec3A::new(0.01 * next(), -0.01 * next(), -1.0).normalize();
-                }
-                if ns.dot(ng) < 0.0 {
-                    ns = -ns;
-                }
-                let wo = unit(&mut next);
-                let mut u = Vec2::new(next(), next());
-                if round % 16 == 0 {
-                    u = Vec2::new([0.0, 1.0f32.next_down()][l % 2], [0.0, 0.999_999_9][l / 16]);
-                }
-                let color = Vec3A::new(next(), next(), next());
-                let s = Surface {
-                    position: (Vec3A::new(next(), next(), next()) - 0.5) * 20.0,
-                    ng,
-                    ns,
-                    nc: ns,
-                    uv: Vec2::ZERO,
-                    material: 0,
-                    color: Vec3A::ONE,
-                };
-                let lane = (l * 7 + round) % PACKET;
-                lanes.push(lane, s.position, ns, ng, wo, color, m, (0.5, u, 0.5));
-                cases.push((conductor, sample_lobes(&m, color, &s, wo, 0.5, 0.5, u)));
-            }
-            lanes.compute();
-            assert_eq!(lanes.mask.count_ones() as usize, cases.len());
-            for (l, (conductor, theirs)) in cases.iter().enumerate() {
-                let ours = lanes.vertex((l * 7 + round) % PACKET).sample;
-                let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
-                assert_eq!(ours.valid, theirs.valid, "lane {l}, round {round}");
-                if !ours.valid {
-                    outcomes[0] += 1;
-                    continue;
-                }
-                outcomes[1 + usize::from(*conductor)] += 1;
-                assert_eq!(bits(ours.wi), bits(theirs.wi), "lane {l}, round {round}");
-                assert_eq!(bits(ours.weight), bits(theirs.weight), "lane {l}");
-                assert_eq!(ours.pdf.to_bits(), theirs.pdf.to_bits(), "lane {l}");
-                assert_eq!(ours.eta.to_bits(), theirs.eta.to_bits(), "lane {l}");
-                assert_eq!(ours.delta, theirs.delta);
-            }
-        }
+                m
+            },
+            |_, m| m.conductor,
+        );
         // Invalid samples, and valid ones of both Fresnel terms, were all met often.
         assert!(outcomes.iter().all(|&n| n > 300), "{outcomes:?}");
     }
