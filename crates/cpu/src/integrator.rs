@@ -85,9 +85,8 @@ pub struct ShadowTest {
 }
 
 /// The vertices of a packet's paths whose shading waits to be computed side by side, by
-/// kind of material:
-/// [`Path::step`] leaves them here, the caller computes each kind and goes on with
-/// [`Path::leave_diffuse`] and [`Path::leave_sampled`].
+/// kind of material: [`Path::step`] leaves them here, the caller computes each kind and goes
+/// on with [`Path::leave_diffuse`] and [`Path::leave_sampled`].
 #[derive(Debug, Clone, Default)]
 pub struct ShadingLanes {
     /// Purely diffuse vertices.
