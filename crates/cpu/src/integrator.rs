@@ -21,7 +21,7 @@ use crate::material::{
     eval_material, has_continuous_material_lobe, is_lambert, lobes_params, material_absorption,
     material_albedo, material_at, sample_material,
 };
-use crate::microfacet::BsdfSample;
+use crate::microfacet::{BsdfEval, BsdfSample};
 use crate::sampler::{Draw, Sampler};
 use crate::sampling::power_heuristic;
 use crate::surface::surface_at;
@@ -177,8 +177,9 @@ impl Path {
     /// diffuse surface the rest of the bounce (the BSDF sample, and the light sample of a quad
     /// or a constant sky) is left to `diffuse` as lane `lane`: once
     /// [`DiffuseLanes::compute`] ran, [`Path::leave_diffuse`] goes on. On rough glass or a
-    /// rough mirror (where `mirror_lanes`) the BSDF sample is left to `glass` or `glossy`
-    /// likewise, and [`Path::leave_sampled`] goes on.
+    /// rough mirror (where `mirror_lanes`) the BSDF sample, and the evaluation towards the
+    /// light sample, are left to `glass` or `glossy` likewise, and [`Path::leave_sampled`]
+    /// goes on.
     #[inline(always)]
     pub fn step(
         &mut self,
@@ -274,6 +275,12 @@ impl Path {
             (u_light_select.x, u_lobe.x, u_fresnel.x, u_rr.x);
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
         let lambert = is_lambert(material);
+        // Rough glass or a rough mirror alone: the lobe is the mixture's only one (u_lobe
+        // below its weight, 1); its sample, and its evaluation towards the light sample, wait
+        // for the lanes.
+        let sampled_lanes = lobes_params(material).filter(|m| {
+            !lambert && u_lobe < 1.0 && (m.is_rough_glass() || mirror_lanes && m.is_rough_mirror())
+        });
         let mut shadow = None;
         if continuous {
             let choice = choose_light(scene, params, u_light_select);
@@ -295,23 +302,13 @@ impl Path {
                     }
                     None => sample_light(scene, params, s.position, n, u_light_select, u_light),
                 };
-                if ls.valid {
-                    let e = eval_material(material, &s, wo, ls.wi);
-                    if e.f.max_element() > 0.0 {
-                        self.sample.rays += 1;
-                        let (ray, t_max) = shadow_ray(s.position, s.ng, &ls);
-                        let weight = if ls.mis {
-                            power_heuristic(ls.pdf, e.pdf)
-                        } else {
-                            1.0
-                        };
-                        let radiance = light_radiance(scene, params, &ls);
-                        let radiance = self.throughput * e.f * radiance * weight / ls.pdf;
-                        shadow = Some(ShadowTest {
-                            ray,
-                            t_max,
-                            radiance,
-                        });
+                match sampled_lanes {
+                    _ if !ls.valid => {}
+                    Some(m) if m.is_rough_glass() => glass.push_light(lane, &ls),
+                    Some(_) => glossy.push_light(lane, &ls),
+                    None => {
+                        let e = eval_material(material, &s, wo, ls.wi);
+                        shadow = self.shadow_test(scene, params, s.position, s.ng, &ls, &e);
                     }
                 }
             }
@@ -322,21 +319,15 @@ impl Path {
             diffuse.push(lane, s.position, n, ng, wo, color, u_bsdf, u_rr);
             return shadow;
         }
-        // Rough glass or a rough mirror alone: the lobe is the mixture's only one (u_lobe
-        // below its weight, 1).
-        if let Some(m) = lobes_params(material)
-            && u_lobe < 1.0
-        {
+        if let Some(m) = sampled_lanes {
             let (position, ng, color) = (s.position, s.ng, material.base_color);
             let u = (u_fresnel, u_bsdf, u_rr);
             if m.is_rough_glass() {
                 glass.push(lane, position, s.ns, ng, wo, color, m, u);
-                return shadow;
-            }
-            if mirror_lanes && m.is_rough_mirror() {
+            } else {
                 glossy.push(lane, position, s.ns, ng, wo, color, m, u);
-                return shadow;
             }
+            return shadow;
         }
         let bs = sample_material(material, &s, wo, u_lobe, u_fresnel, u_bsdf);
         self.bounce(params, &bs, s.position, s.ng, n, u_rr);
@@ -344,16 +335,54 @@ impl Path {
     }
 
     /// Goes on from the vertex that lane `lane` of `lanes` holds, once
-    /// [`SampleLanes::compute`] ran.
+    /// [`SampleLanes::compute`] ran: returns the shadow test of the light sample left to it,
+    /// as [`Path::step`] returns its own.
     #[inline(always)]
     pub fn leave_sampled<M: LaneBsdf>(
         &mut self,
+        scene: &CpuScene,
         params: &GpuRenderParams,
         lanes: &SampleLanes<M>,
         lane: usize,
-    ) {
+    ) -> Option<ShadowTest> {
         let v = lanes.vertex(lane);
+        let shadow = v
+            .light
+            .and_then(|(ls, e)| self.shadow_test(scene, params, v.position, v.ng, &ls, &e));
         self.bounce(params, &v.sample, v.position, v.ng, v.n, v.u_rr);
+        shadow
+    }
+
+    /// The shadow test of the valid light sample `ls` at `position` (geometric normal
+    /// `ng`), where the BSDF's evaluation towards it is `e`; none where the BSDF passes
+    /// nothing on.
+    #[inline(always)]
+    fn shadow_test(
+        &mut self,
+        scene: &CpuScene,
+        params: &GpuRenderParams,
+        position: Vec3A,
+        ng: Vec3A,
+        ls: &LightSample,
+        e: &BsdfEval,
+    ) -> Option<ShadowTest> {
+        if e.f.max_element() > 0.0 {
+            self.sample.rays += 1;
+            let (ray, t_max) = shadow_ray(position, ng, ls);
+            let weight = if ls.mis {
+                power_heuristic(ls.pdf, e.pdf)
+            } else {
+                1.0
+            };
+            let radiance = light_radiance(scene, params, ls);
+            let radiance = self.throughput * e.f * radiance * weight / ls.pdf;
+            return Some(ShadowTest {
+                ray,
+                t_max,
+                radiance,
+            });
+        }
+        None
     }
 
     /// Goes on from the diffuse vertex that lane `lane` of `diffuse` holds, once
@@ -455,11 +484,11 @@ pub fn trace_path(
         }
         if lanes.glass.mask != 0 {
             lanes.glass.compute();
-            path.leave_sampled(params, &lanes.glass, 0);
+            shadow = shadow.or(path.leave_sampled(scene, params, &lanes.glass, 0));
         }
         if lanes.glossy.mask != 0 {
             lanes.glossy.compute();
-            path.leave_sampled(params, &lanes.glossy, 0);
+            shadow = shadow.or(path.leave_sampled(scene, params, &lanes.glossy, 0));
         }
         if let Some(shadow) = shadow
             && !tracer.occluded(&shadow.ray, shadow.t_max)
