@@ -278,9 +278,13 @@ impl Path {
         // Rough glass or a rough mirror alone: the lobe is the mixture's only one (u_lobe
         // below its weight, 1); its sample, and its evaluation towards the light sample, wait
         // for the lanes.
-        let sampled_lanes = lobes_params(material).filter(|m| {
-            !lambert && u_lobe < 1.0 && (m.is_rough_glass() || mirror_lanes && m.is_rough_mirror())
-        });
+        let sampled_lanes = if lambert {
+            None
+        } else {
+            lobes_params(material).filter(|m| {
+                u_lobe < 1.0 && (m.is_rough_glass() || mirror_lanes && m.is_rough_mirror())
+            })
+        };
         let mut shadow = None;
         if continuous {
             let choice = choose_light(scene, params, u_light_select);
