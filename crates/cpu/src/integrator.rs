@@ -87,7 +87,7 @@ pub struct ShadowTest {
 /// The vertices of a packet's paths whose shading waits to be computed side by side, by
 /// kind of material: [`Path::step`] leaves them here, the caller computes each kind and goes
 /// on with [`Path::leave_diffuse`] and [`Path::leave_sampled`].
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct ShadingLanes {
     /// Purely diffuse vertices.
     pub diffuse: DiffuseLanes,
@@ -95,6 +95,18 @@ pub struct ShadingLanes {
     pub glass: GlassLanes,
     /// Rough mirror vertices (the lobes model's rough specular reflection alone).
     pub glossy: GlossyLanes,
+}
+
+impl Default for ShadingLanes {
+    // Inlined, as the whole row renderer is (a derived `default` was left out of line).
+    #[inline(always)]
+    fn default() -> Self {
+        Self {
+            diffuse: DiffuseLanes::default(),
+            glass: GlassLanes::default(),
+            glossy: GlossyLanes::default(),
+        }
+    }
 }
 
 impl ShadingLanes {
