@@ -84,9 +84,6 @@ pub struct SampledVertex {
     pub n: Vec3A,
     /// The dimension deciding Russian roulette there.
     pub u_rr: f32,
-    /// The light sample left with the vertex ([`SampleLanes::push_light`]), and the BSDF's
-    /// evaluation towards it.
-    pub light: Option<(LightSample, BsdfEval)>,
 }
 
 /// Per lane, a vertex on a material of kind `M` waiting for its BSDF sample
@@ -295,14 +292,20 @@ impl<M: LaneBsdf> SampleLanes<M> {
                 -ns
             },
             u_rr: self.u_rr[l],
-            light: (self.lit >> l & 1 != 0).then(|| {
-                let e = BsdfEval {
-                    f: lane(&self.light_f, l),
-                    pdf: self.light_pdf[l],
-                };
-                (self.lights[l], e)
-            }),
         }
+    }
+
+    /// Lane `l`'s light sample ([`SampleLanes::push_light`]), if it has one, and the
+    /// BSDF's evaluation towards it, once [`SampleLanes::compute`] ran.
+    #[inline(always)]
+    pub fn light(&self, l: usize) -> Option<(&LightSample, BsdfEval)> {
+        (self.lit >> l & 1 != 0).then(|| {
+            let e = BsdfEval {
+                f: lane(&self.light_f, l),
+                pdf: self.light_pdf[l],
+            };
+            (&self.lights[l], e)
+        })
     }
 }
 
@@ -396,8 +399,9 @@ pub(crate) mod tests {
             let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
             for (l, (m, theirs, light)) in cases.iter().enumerate() {
                 let vertex = lanes.vertex((l * 7 + round) % PACKET);
-                assert_eq!(vertex.light.is_some(), light.is_some());
-                if let (Some((ls, ours)), Some((wi, theirs))) = (vertex.light, light) {
+                let ours = lanes.light((l * 7 + round) % PACKET);
+                assert_eq!(ours.is_some(), light.is_some());
+                if let (Some((ls, ours)), Some((wi, theirs))) = (ours, light) {
                     assert_eq!(bits(ls.wi), bits(*wi));
                     assert_eq!(bits(ours.f), bits(theirs.f), "lane {l}, round {round}");
                     assert_eq!(ours.pdf.to_bits(), theirs.pdf.to_bits(), "lane {l}");
