@@ -1,7 +1,7 @@
 //! Unidirectional path tracing with next-event estimation and MIS. Twin of
 //! `integrator.wgsl` (same loop, same order of sample dimensions).
 
-use glam::Vec3A;
+use glam::{Vec2, Vec3A};
 use pathlight_core::gpu_types::{
     GpuAccumPixel, GpuAovPixel, GpuRenderParams, KIND_QUAD, LIGHT_AREA, NO_LIGHT,
 };
@@ -11,7 +11,7 @@ use crate::bvh::Hit;
 use crate::camera::camera_ray;
 use crate::cpu_scene::CpuScene;
 use crate::diffuse::DiffuseLanes;
-use crate::environment::{env_escape, has_env_map};
+use crate::environment::{env_escape, has_env_map, sample_environment};
 use crate::glass::GlassLanes;
 use crate::glossy::GlossyLanes;
 use crate::intersect::Ray;
@@ -22,6 +22,7 @@ use crate::material::{
     material_albedo, material_at, sample_material,
 };
 use crate::microfacet::{BsdfEval, BsdfSample};
+use crate::packet::{Lanes, PACKET};
 use crate::sampler::{Draw, Sampler};
 use crate::sampling::power_heuristic;
 use crate::surface::surface_at;
@@ -85,8 +86,9 @@ pub struct ShadowTest {
 }
 
 /// The vertices of a packet's paths whose shading waits to be computed side by side, by
-/// kind of material: [`Path::step`] leaves them here, the caller computes each kind and goes
-/// on with [`Path::leave_diffuse`] and [`Path::leave_sampled`].
+/// kind of material: [`Path::step`] leaves them here, the caller takes their environment
+/// map light samples ([`ShadingLanes::sample_map_lights`]), computes each kind and goes on
+/// with [`Path::leave_diffuse`] and [`Path::leave_sampled`].
 #[derive(Debug, Clone)]
 pub struct ShadingLanes {
     /// Purely diffuse vertices.
@@ -95,6 +97,10 @@ pub struct ShadingLanes {
     pub glass: GlassLanes,
     /// Rough mirror vertices (the lobes model's rough specular reflection alone).
     pub glossy: GlossyLanes,
+    /// Bit `l` set: lane `l` (a vertex of one of the kinds above) samples the environment
+    /// map at `map_u[l]`, its light sample still to be taken.
+    map_lights: Lanes,
+    map_u: [Vec2; PACKET],
 }
 
 impl Default for ShadingLanes {
@@ -106,6 +112,8 @@ impl Default for ShadingLanes {
             diffuse: DiffuseLanes::default(),
             glass: GlassLanes::default(),
             glossy: GlossyLanes::default(),
+            map_lights: 0,
+            map_u: [Vec2::ZERO; PACKET],
         }
     }
 }
@@ -117,6 +125,32 @@ impl ShadingLanes {
         self.diffuse.clear();
         self.glass.clear();
         self.glossy.clear();
+        self.map_lights = 0;
+    }
+
+    /// Takes the environment map's light samples left waiting, one lane after another in a
+    /// loop of their own, so that one lane's loads from the map's megabytes of tables overlap
+    /// the next's (taken in each lane's step, they stalled it: env-sun 9-13% slower), and
+    /// gives them to their lanes' kinds to evaluate the BSDF towards.
+    #[inline(always)]
+    pub fn sample_map_lights(&mut self, scene: &CpuScene, params: &GpuRenderParams) {
+        let mut left = self.map_lights;
+        while left != 0 {
+            let l = left.trailing_zeros() as usize;
+            left &= left - 1;
+            // (A map's sample does not depend on the normal.)
+            let ls = sample_environment(scene, params, Vec3A::ZERO, self.map_u[l]);
+            if !ls.valid {
+                continue;
+            }
+            if self.diffuse.mask >> l & 1 != 0 {
+                self.diffuse.push_light(l, &ls);
+            } else if self.glass.mask >> l & 1 != 0 {
+                self.glass.push_light(l, &ls);
+            } else {
+                self.glossy.push_light(l, &ls);
+            }
+        }
     }
 }
 
@@ -192,7 +226,8 @@ impl Path {
     /// [`DiffuseLanes::compute`] ran, [`Path::leave_diffuse`] goes on. On rough glass or a
     /// rough mirror (where `mirror_lanes`) the BSDF sample, and the evaluation towards the
     /// light sample, are left to `glass` or `glossy` likewise, and [`Path::leave_sampled`]
-    /// goes on.
+    /// goes on. At such vertices a light sample of the environment map is left to `lanes`
+    /// too, for [`ShadingLanes::sample_map_lights`] to take before the kinds are computed.
     #[inline(always)]
     pub fn step(
         &mut self,
@@ -207,6 +242,8 @@ impl Path {
             diffuse,
             glass,
             glossy,
+            map_lights,
+            map_u,
         } = lanes;
         self.depth += 1;
         self.sample.rays += 1;
@@ -312,6 +349,13 @@ impl Path {
             } else if sky {
                 let radiance = Vec3A::from(params.environment);
                 diffuse.push_sky_light(lane, radiance, params.env_pmf, u_light, self.throughput);
+            } else if (lambert || sampled_lanes.is_some())
+                && choice.is_none()
+                && u_light_select < params.env_pmf
+                && has_env_map(params)
+            {
+                *map_lights |= 1 << lane;
+                map_u[lane] = u_light;
             } else {
                 let ls = match choice {
                     Some((light, pmf, u_part)) => {
@@ -408,16 +452,22 @@ impl Path {
     #[inline(always)]
     pub fn leave_diffuse(
         &mut self,
+        scene: &CpuScene,
         params: &GpuRenderParams,
         diffuse: &DiffuseLanes,
         lane: usize,
     ) -> Option<ShadowTest> {
         let v = diffuse.vertex(lane);
-        if v.shadow.is_some() {
+        let shadow = if v.shadow.is_some() {
             self.sample.rays += 1;
-        }
+            v.shadow
+        } else {
+            diffuse
+                .given_light(lane)
+                .and_then(|(ls, e)| self.shadow_test(scene, params, v.position, v.ng, ls, &e))
+        };
         self.bounce(params, &v.sample, v.position, v.ng, v.n, v.u_rr);
-        v.shadow
+        shadow
     }
 
     /// Goes on along BSDF sample `bs`, drawn at `position` (geometric normal `ng`, shading
@@ -495,9 +545,10 @@ pub fn trace_path(
         let hit = tracer.intersect(&path.ray, T_MAX);
         lanes.clear();
         let mut shadow = path.step(scene, params, hit, &mut lanes, 0, true);
+        lanes.sample_map_lights(scene, params);
         if lanes.diffuse.mask != 0 {
             lanes.diffuse.compute();
-            shadow = shadow.or(path.leave_diffuse(params, &lanes.diffuse, 0));
+            shadow = shadow.or(path.leave_diffuse(scene, params, &lanes.diffuse, 0));
         }
         if lanes.glass.mask != 0 {
             lanes.glass.compute();

@@ -106,6 +106,7 @@ fn render_row<const MIRROR_LANES: bool>(
                 shadow_tests.add(l, shadow);
             }
         }
+        shading.sample_map_lights(scene, params);
         let diffuse = &mut shading.diffuse;
         if diffuse.mask != 0 {
             diffuse.compute();
@@ -114,7 +115,7 @@ fn render_row<const MIRROR_LANES: bool>(
                 let l = left.trailing_zeros() as usize;
                 left &= left - 1;
                 if let Some((_, path)) = &mut lanes[l] {
-                    shadow_tests.add(l, path.leave_diffuse(params, diffuse, l));
+                    shadow_tests.add(l, path.leave_diffuse(scene, params, diffuse, l));
                 }
             }
         }

@@ -315,11 +315,23 @@ fn every_instruction_set_renders_the_same_image() {
 
 #[test]
 fn packets_trace_each_path_as_it_is_traced_alone() {
-    // The renderer traces its paths side by side, their rays in packets; each path must come
-    // out as `trace_path` (one ray at a time) gives it: same samples, same hits (pixel sums
-    // within f64 rounding). Two primitives at exactly the same distance may be resolved
-    // differently by the two walks: at most 0.5% of the pixels may differ.
-    let mut scene = load_scene_file(&refs().join("cornell-materials.toml")).unwrap();
+    packets_as_alone("cornell-materials");
+}
+
+#[test]
+fn packets_trace_each_path_as_it_is_traced_alone_under_a_map() {
+    // A packet's environment map light samples are taken together, then handed to the
+    // diffuse, rough glass and rough mirror lanes they belong to.
+    packets_as_alone("env-sun");
+}
+
+/// The renderer traces its paths side by side, their rays in packets; each path of the
+/// reference scene `name` must come out as `trace_path` (one ray at a time) gives it: same
+/// samples, same hits (pixel sums within f64 rounding). Two primitives at exactly the same
+/// distance may be resolved differently by the two walks: at most 0.5% of the pixels may
+/// differ.
+fn packets_as_alone(name: &str) {
+    let mut scene = load_scene_file(&refs().join(format!("{name}.toml"))).unwrap();
     let (size, spp) = (48, 4);
     scene.camera.width = size;
     scene.camera.height = size;
