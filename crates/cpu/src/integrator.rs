@@ -224,10 +224,11 @@ impl Path {
     /// diffuse surface the rest of the bounce (the BSDF sample, and the light sample of a quad
     /// or a constant sky) is left to `diffuse` as lane `lane`: once
     /// [`DiffuseLanes::compute`] ran, [`Path::leave_diffuse`] goes on. On rough glass or a
-    /// rough mirror (where `mirror_lanes`) the BSDF sample, and the evaluation towards the
-    /// light sample, are left to `glass` or `glossy` likewise, and [`Path::leave_sampled`]
-    /// goes on. At such vertices a light sample of the environment map is left to `lanes`
-    /// too, for [`ShadingLanes::sample_map_lights`] to take before the kinds are computed.
+    /// rough mirror (where `mirror_lanes`) the BSDF sample is left to `glass` or `glossy`
+    /// likewise, and [`Path::leave_sampled`] goes on. At all such vertices a light sample of
+    /// the environment map is left to `lanes` too, for
+    /// [`ShadingLanes::sample_map_lights`] to take before the kinds are computed (and the
+    /// kind then evaluates the BSDF towards it).
     #[inline(always)]
     pub fn step(
         &mut self,
@@ -326,8 +327,7 @@ impl Path {
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
         let lambert = is_lambert(material);
         // Rough glass or a rough mirror alone: the lobe is the mixture's only one (u_lobe
-        // below its weight, 1); its sample, and its evaluation towards the light sample, wait
-        // for the lanes.
+        // below its weight, 1); its sample waits for the lanes.
         let sampled_lanes = if lambert {
             None
         } else {
@@ -363,14 +363,9 @@ impl Path {
                     }
                     None => sample_light(scene, params, s.position, n, u_light_select, u_light),
                 };
-                match sampled_lanes {
-                    _ if !ls.valid => {}
-                    Some(m) if m.is_rough_glass() => glass.push_light(lane, &ls),
-                    Some(_) => glossy.push_light(lane, &ls),
-                    None => {
-                        let e = eval_material(material, &s, wo, ls.wi);
-                        shadow = self.shadow_test(scene, params, s.position, s.ng, &ls, &e);
-                    }
+                if ls.valid {
+                    let e = eval_material(material, &s, wo, ls.wi);
+                    shadow = self.shadow_test(scene, params, s.position, s.ng, &ls, &e);
                 }
             }
         }
