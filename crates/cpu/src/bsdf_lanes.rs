@@ -71,6 +71,20 @@ pub trait LaneBsdf: Default {
     fn eval(&self, l: usize, v: &LaneVertex, wi: [f32; 3]) -> LaneEval;
 }
 
+/// A vertex's light sample with the BSDF's evaluation towards it, computed side by side:
+/// what its shadow test needs.
+#[derive(Debug, Clone, Copy)]
+pub struct LitVertex<'a> {
+    /// The light sample.
+    pub light: &'a LightSample,
+    /// The BSDF's evaluation towards it.
+    pub eval: BsdfEval,
+    /// The vertex.
+    pub position: Vec3A,
+    /// Its geometric normal (on either side: the shadow ray leaves on the light's).
+    pub ng: Vec3A,
+}
+
 /// A vertex with its BSDF sample, and what the path needs to go on from it.
 #[derive(Debug, Clone, Copy)]
 pub struct SampledVertex {
@@ -298,13 +312,15 @@ impl<M: LaneBsdf> SampleLanes<M> {
     /// Lane `l`'s light sample ([`SampleLanes::push_light`]), if it has one, and the
     /// BSDF's evaluation towards it, once [`SampleLanes::compute`] ran.
     #[inline(always)]
-    pub fn light(&self, l: usize) -> Option<(&LightSample, BsdfEval)> {
-        (self.lit >> l & 1 != 0).then(|| {
-            let e = BsdfEval {
+    pub fn light(&self, l: usize) -> Option<LitVertex<'_>> {
+        (self.lit >> l & 1 != 0).then(|| LitVertex {
+            light: &self.lights[l],
+            eval: BsdfEval {
                 f: lane(&self.light_f, l),
                 pdf: self.light_pdf[l],
-            };
-            (&self.lights[l], e)
+            },
+            position: lane(&self.position, l),
+            ng: lane(&self.ng, l),
         })
     }
 }
@@ -401,8 +417,9 @@ pub(crate) mod tests {
                 let vertex = lanes.vertex((l * 7 + round) % PACKET);
                 let ours = lanes.light((l * 7 + round) % PACKET);
                 assert_eq!(ours.is_some(), light.is_some());
-                if let (Some((ls, ours)), Some((wi, theirs))) = (ours, light) {
-                    assert_eq!(bits(ls.wi), bits(*wi));
+                if let (Some(ours), Some((wi, theirs))) = (ours, light) {
+                    assert_eq!(bits(ours.light.wi), bits(*wi));
+                    let ours = ours.eval;
                     assert_eq!(bits(ours.f), bits(theirs.f), "lane {l}, round {round}");
                     assert_eq!(ours.pdf.to_bits(), theirs.pdf.to_bits(), "lane {l}");
                     outcomes[3] += usize::from(theirs.pdf > 0.0);

@@ -18,6 +18,7 @@ use std::f32::consts::{FRAC_1_PI, PI};
 
 use glam::{Vec2, Vec3A};
 
+use crate::bsdf_lanes::LitVertex;
 use crate::cpu_scene::CpuScene;
 use crate::integrator::{ShadowTest, T_MAX};
 use crate::intersect::Ray;
@@ -441,13 +442,15 @@ impl DiffuseLanes {
     /// Lane `l`'s light sample given to the lanes ([`DiffuseLanes::push_light`]), if it has
     /// one, and the BSDF's evaluation towards it, once [`DiffuseLanes::compute`] ran.
     #[inline(always)]
-    pub fn given_light(&self, l: usize) -> Option<(&LightSample, BsdfEval)> {
-        (self.given_light >> l & 1 != 0).then(|| {
-            let e = BsdfEval {
+    pub fn given_light(&self, l: usize) -> Option<LitVertex<'_>> {
+        (self.given_light >> l & 1 != 0).then(|| LitVertex {
+            light: &self.given[l],
+            eval: BsdfEval {
                 f: lane(&self.given_f, l),
                 pdf: self.given_pdf[l],
-            };
-            (&self.given[l], e)
+            },
+            position: lane(&self.position, l),
+            ng: lane(&self.ng, l),
         })
     }
 }
@@ -547,8 +550,9 @@ mod tests {
                 let vertex = lanes.vertex(l);
                 let ours = lanes.given_light(l);
                 assert_eq!(ours.is_some(), light.is_some());
-                if let (Some((ls, ours)), Some((wi, theirs))) = (ours, light) {
-                    assert_eq!(bits(ls.wi), bits(*wi));
+                if let (Some(ours), Some((wi, theirs))) = (ours, light) {
+                    assert_eq!(bits(ours.light.wi), bits(*wi));
+                    let ours = ours.eval;
                     assert_eq!(bits(ours.f), bits(theirs.f), "lane {l}, round {round}");
                     assert_eq!(ours.pdf.to_bits(), theirs.pdf.to_bits(), "lane {l}");
                     checked[2] += usize::from(theirs.pdf > 0.0);

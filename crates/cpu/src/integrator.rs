@@ -6,7 +6,7 @@ use pathlight_core::gpu_types::{
     GpuAccumPixel, GpuAovPixel, GpuRenderParams, KIND_QUAD, LIGHT_AREA, NO_LIGHT,
 };
 
-use crate::bsdf_lanes::{LaneBsdf, SampleLanes};
+use crate::bsdf_lanes::{LaneBsdf, LitVertex, SampleLanes};
 use crate::bvh::Hit;
 use crate::camera::camera_ray;
 use crate::cpu_scene::CpuScene;
@@ -86,9 +86,10 @@ pub struct ShadowTest {
 }
 
 /// The vertices of a packet's paths whose shading waits to be computed side by side, by
-/// kind of material: [`Path::step`] leaves them here, the caller takes their environment
-/// map light samples ([`ShadingLanes::sample_map_lights`]), computes each kind and goes on
-/// with [`Path::leave_diffuse`] and [`Path::leave_sampled`].
+/// kind of material: [`Path::step`] leaves them here, the caller computes them
+/// ([`ShadingLanes::compute`]), takes the shadow tests of their environment map light
+/// samples ([`Path::map_light_test`]) and goes on with [`Path::leave_diffuse`] and
+/// [`Path::leave_sampled`].
 #[derive(Debug, Clone)]
 pub struct ShadingLanes {
     /// Purely diffuse vertices.
@@ -128,12 +129,47 @@ impl ShadingLanes {
         self.map_lights = 0;
     }
 
+    /// Takes the environment map's light samples left waiting
+    /// (`sample_map_lights`), then computes each kind's lanes.
+    #[inline(always)]
+    pub fn compute(&mut self, scene: &CpuScene, params: &GpuRenderParams) {
+        self.sample_map_lights(scene, params);
+        if self.diffuse.mask != 0 {
+            self.diffuse.compute();
+        }
+        if self.glass.mask != 0 {
+            self.glass.compute();
+        }
+        if self.glossy.mask != 0 {
+            self.glossy.compute();
+        }
+    }
+
+    /// Bit `l` set: lane `l` left an environment map light sample here.
+    #[inline(always)]
+    pub fn map_lights(&self) -> Lanes {
+        self.map_lights
+    }
+
+    /// Lane `l`'s environment map light sample, if it left a valid one here, with the
+    /// BSDF's evaluation towards it, once [`ShadingLanes::compute`] ran.
+    #[inline(always)]
+    fn map_light(&self, l: usize) -> Option<LitVertex<'_>> {
+        if self.diffuse.mask >> l & 1 != 0 {
+            self.diffuse.given_light(l)
+        } else if self.glass.mask >> l & 1 != 0 {
+            self.glass.light(l)
+        } else {
+            self.glossy.light(l)
+        }
+    }
+
     /// Takes the environment map's light samples left waiting, one lane after another in a
     /// loop of their own, so that one lane's loads from the map's megabytes of tables overlap
     /// the next's (taken in each lane's step, they stalled it: env-sun 9-13% slower), and
     /// gives them to their lanes' kinds to evaluate the BSDF towards.
     #[inline(always)]
-    pub fn sample_map_lights(&mut self, scene: &CpuScene, params: &GpuRenderParams) {
+    fn sample_map_lights(&mut self, scene: &CpuScene, params: &GpuRenderParams) {
         let mut left = self.map_lights;
         while left != 0 {
             let l = left.trailing_zeros() as usize;
@@ -226,9 +262,9 @@ impl Path {
     /// [`DiffuseLanes::compute`] ran, [`Path::leave_diffuse`] goes on. On rough glass or a
     /// rough mirror (where `mirror_lanes`) the BSDF sample is left to `glass` or `glossy`
     /// likewise, and [`Path::leave_sampled`] goes on. At all such vertices a light sample of
-    /// the environment map is left to `lanes` too, for
-    /// [`ShadingLanes::sample_map_lights`] to take before the kinds are computed (and the
-    /// kind then evaluates the BSDF towards it).
+    /// the environment map is left to `lanes` too: [`ShadingLanes::compute`] takes it and
+    /// the kind evaluates the BSDF towards it, then [`Path::map_light_test`] gives its
+    /// shadow test.
     #[inline(always)]
     pub fn step(
         &mut self,
@@ -391,22 +427,31 @@ impl Path {
     }
 
     /// Goes on from the vertex that lane `lane` of `lanes` holds, once
-    /// [`SampleLanes::compute`] ran: returns the shadow test of the light sample left to it,
-    /// as [`Path::step`] returns its own.
+    /// [`SampleLanes::compute`] ran.
     #[inline(always)]
     pub fn leave_sampled<M: LaneBsdf>(
         &mut self,
-        scene: &CpuScene,
         params: &GpuRenderParams,
         lanes: &SampleLanes<M>,
         lane: usize,
-    ) -> Option<ShadowTest> {
+    ) {
         let v = lanes.vertex(lane);
-        let shadow = lanes
-            .light(lane)
-            .and_then(|(ls, e)| self.shadow_test(scene, params, v.position, v.ng, ls, &e));
         self.bounce(params, &v.sample, v.position, v.ng, v.n, v.u_rr);
-        shadow
+    }
+
+    /// The shadow test of the environment map light sample that lane `lane` of `lanes`
+    /// left there, once [`ShadingLanes::compute`] ran and before the path leaves the vertex
+    /// (it reads the throughput that reached the vertex), as [`Path::step`] returns its own.
+    #[inline(always)]
+    pub fn map_light_test(
+        &mut self,
+        scene: &CpuScene,
+        params: &GpuRenderParams,
+        lanes: &ShadingLanes,
+        lane: usize,
+    ) -> Option<ShadowTest> {
+        let v = lanes.map_light(lane)?;
+        self.shadow_test(scene, params, v.position, v.ng, v.light, &v.eval)
     }
 
     /// The shadow test of the valid light sample `ls` at `position` (geometric normal
@@ -442,27 +487,21 @@ impl Path {
     }
 
     /// Goes on from the diffuse vertex that lane `lane` of `diffuse` holds, once
-    /// [`DiffuseLanes::compute`] ran: returns the shadow test of the light sample left to it,
-    /// as [`Path::step`] returns its own.
+    /// [`DiffuseLanes::compute`] ran: returns the shadow test of the quad or sky light sample
+    /// left to it, as [`Path::step`] returns its own.
     #[inline(always)]
     pub fn leave_diffuse(
         &mut self,
-        scene: &CpuScene,
         params: &GpuRenderParams,
         diffuse: &DiffuseLanes,
         lane: usize,
     ) -> Option<ShadowTest> {
         let v = diffuse.vertex(lane);
-        let shadow = if v.shadow.is_some() {
+        if v.shadow.is_some() {
             self.sample.rays += 1;
-            v.shadow
-        } else {
-            diffuse
-                .given_light(lane)
-                .and_then(|(ls, e)| self.shadow_test(scene, params, v.position, v.ng, ls, &e))
-        };
+        }
         self.bounce(params, &v.sample, v.position, v.ng, v.n, v.u_rr);
-        shadow
+        v.shadow
     }
 
     /// Goes on along BSDF sample `bs`, drawn at `position` (geometric normal `ng`, shading
@@ -540,18 +579,18 @@ pub fn trace_path(
         let hit = tracer.intersect(&path.ray, T_MAX);
         lanes.clear();
         let mut shadow = path.step(scene, params, hit, &mut lanes, 0, true);
-        lanes.sample_map_lights(scene, params);
+        lanes.compute(scene, params);
+        if lanes.map_lights() != 0 {
+            shadow = shadow.or(path.map_light_test(scene, params, &lanes, 0));
+        }
         if lanes.diffuse.mask != 0 {
-            lanes.diffuse.compute();
-            shadow = shadow.or(path.leave_diffuse(scene, params, &lanes.diffuse, 0));
+            shadow = shadow.or(path.leave_diffuse(params, &lanes.diffuse, 0));
         }
         if lanes.glass.mask != 0 {
-            lanes.glass.compute();
-            shadow = shadow.or(path.leave_sampled(scene, params, &lanes.glass, 0));
+            path.leave_sampled(params, &lanes.glass, 0);
         }
         if lanes.glossy.mask != 0 {
-            lanes.glossy.compute();
-            shadow = shadow.or(path.leave_sampled(scene, params, &lanes.glossy, 0));
+            path.leave_sampled(params, &lanes.glossy, 0);
         }
         if let Some(shadow) = shadow
             && !tracer.occluded(&shadow.ray, shadow.t_max)

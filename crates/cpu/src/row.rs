@@ -106,21 +106,26 @@ fn render_row<const MIRROR_LANES: bool>(
                 shadow_tests.add(l, shadow);
             }
         }
-        shading.sample_map_lights(scene, params);
-        let diffuse = &mut shading.diffuse;
-        if diffuse.mask != 0 {
-            diffuse.compute();
-            let mut left = diffuse.mask;
-            while left != 0 {
-                let l = left.trailing_zeros() as usize;
-                left &= left - 1;
-                if let Some((_, path)) = &mut lanes[l] {
-                    shadow_tests.add(l, path.leave_diffuse(scene, params, diffuse, l));
-                }
+        shading.compute(scene, params);
+        let mut left = shading.map_lights();
+        while left != 0 {
+            let l = left.trailing_zeros() as usize;
+            left &= left - 1;
+            if let Some((_, path)) = &mut lanes[l] {
+                shadow_tests.add(l, path.map_light_test(scene, params, &shading, l));
             }
         }
-        leave_sampled(&mut lanes, &mut shading.glass, &mut shadow_tests, job);
-        leave_sampled(&mut lanes, &mut shading.glossy, &mut shadow_tests, job);
+        let diffuse = &shading.diffuse;
+        let mut left = diffuse.mask;
+        while left != 0 {
+            let l = left.trailing_zeros() as usize;
+            left &= left - 1;
+            if let Some((_, path)) = &mut lanes[l] {
+                shadow_tests.add(l, path.leave_diffuse(params, diffuse, l));
+            }
+        }
+        leave_sampled(&mut lanes, &shading.glass, params);
+        leave_sampled(&mut lanes, &shading.glossy, params);
         let unblocked = shadow_tests.unblocked;
         let blocked = tracer.occluded_packet(&shadows);
         for (l, lane) in lanes.iter_mut().enumerate() {
@@ -155,25 +160,19 @@ impl ShadowTests<'_> {
     }
 }
 
-/// Computes the BSDF samples (and evaluations towards light samples) that `waiting` holds
-/// for paths of `lanes`, and goes on with those paths, their shadow tests into `shadows`.
+/// Goes on with the paths of `lanes` whose BSDF samples `computed` holds.
 #[inline(always)]
 fn leave_sampled<M: LaneBsdf>(
     lanes: &mut [Option<(usize, Path)>; PACKET],
-    waiting: &mut SampleLanes<M>,
-    shadows: &mut ShadowTests,
-    job: &RowJob,
+    computed: &SampleLanes<M>,
+    params: &GpuRenderParams,
 ) {
-    if waiting.mask == 0 {
-        return;
-    }
-    waiting.compute();
-    let mut left = waiting.mask;
+    let mut left = computed.mask;
     while left != 0 {
         let l = left.trailing_zeros() as usize;
         left &= left - 1;
         if let Some((_, path)) = &mut lanes[l] {
-            shadows.add(l, path.leave_sampled(job.scene, job.params, waiting, l));
+            path.leave_sampled(params, computed, l);
         }
     }
 }
