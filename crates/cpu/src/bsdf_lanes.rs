@@ -219,14 +219,14 @@ impl<M: LaneBsdf> SampleLanes<M> {
     /// waiting compute throw-away values; computing only theirs, gathered into as few
     /// AVX-512 registers as they fill, was slower).
     #[inline(always)]
-    pub fn compute(&mut self) {
+    pub fn compute(&mut self, lights: bool) {
         if self.mask.count_ones() <= ONE_BY_ONE {
             let mut left = self.mask;
             while left != 0 {
                 let l = left.trailing_zeros() as usize;
                 left &= left - 1;
                 self.compute_lane(l);
-                if self.lit >> l & 1 != 0 {
+                if lights && self.lit >> l & 1 != 0 {
                     self.compute_light(l);
                 }
             }
@@ -235,7 +235,7 @@ impl<M: LaneBsdf> SampleLanes<M> {
         for l in 0..PACKET {
             self.compute_lane(l);
         }
-        if self.lit != 0 {
+        if lights && self.lit != 0 {
             for l in 0..PACKET {
                 self.compute_light(l);
             }
@@ -410,7 +410,7 @@ pub(crate) mod tests {
                 });
                 cases.push((m, sample, light));
             }
-            lanes.compute();
+            lanes.compute(true);
             assert_eq!(lanes.mask.count_ones() as usize, cases.len());
             let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
             for (l, (m, theirs, light)) in cases.iter().enumerate() {

@@ -249,7 +249,7 @@ impl DiffuseLanes {
 
     /// Computes every lane side by side (those not waiting compute throw-away values).
     #[inline(always)]
-    pub fn compute(&mut self) {
+    pub fn compute(&mut self, given: bool) {
         // The quads' loop writes every lane; the sky's then its own lanes only, where there
         // are both.
         if self.quad_light != 0 {
@@ -279,7 +279,7 @@ impl DiffuseLanes {
             }
             self.pdf[l] = pdf;
         }
-        if self.given_light != 0 {
+        if given && self.given_light != 0 {
             for l in 0..PACKET {
                 let at = |a: &Lanes3| [a[0][l], a[1][l], a[2][l]];
                 let (n, ng, wo, wi) = (at(&self.n), at(&self.ng), at(&self.wo), at(&self.given_wi));
@@ -544,7 +544,7 @@ mod tests {
                 });
                 cases.push((sample, light));
             }
-            lanes.compute();
+            lanes.compute(true);
             let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
             for (l, (theirs, light)) in cases.iter().enumerate() {
                 let vertex = lanes.vertex(l);
@@ -656,7 +656,7 @@ mod tests {
                     (ray, t_max, throughput * e.f * radiance * weight / ls.pdf)
                 }));
             }
-            lanes.compute();
+            lanes.compute(true);
             for (l, theirs) in cases.into_iter().enumerate() {
                 let ours = lanes.vertex(l).shadow;
                 assert_eq!(ours.is_some(), theirs.is_some(), "lane {l}");

@@ -130,18 +130,21 @@ impl ShadingLanes {
     }
 
     /// Takes the environment map's light samples left waiting
-    /// (`sample_map_lights`), then computes each kind's lanes.
+    /// (`sample_map_lights`), then computes each kind's lanes; `map`: whether the scene has
+    /// a map (where not, the code for its samples is left out when `map` is a constant).
     #[inline(always)]
-    pub fn compute(&mut self, scene: &CpuScene, params: &GpuRenderParams) {
-        self.sample_map_lights(scene, params);
+    pub fn compute(&mut self, scene: &CpuScene, params: &GpuRenderParams, map: bool) {
+        if map {
+            self.sample_map_lights(scene, params);
+        }
         if self.diffuse.mask != 0 {
-            self.diffuse.compute();
+            self.diffuse.compute(map);
         }
         if self.glass.mask != 0 {
-            self.glass.compute();
+            self.glass.compute(map);
         }
         if self.glossy.mask != 0 {
-            self.glossy.compute();
+            self.glossy.compute(map);
         }
     }
 
@@ -274,6 +277,7 @@ impl Path {
         lanes: &mut ShadingLanes,
         lane: usize,
         mirror_lanes: bool,
+        map_lanes: bool,
     ) -> Option<ShadowTest> {
         let ShadingLanes {
             diffuse,
@@ -385,7 +389,8 @@ impl Path {
             } else if sky {
                 let radiance = Vec3A::from(params.environment);
                 diffuse.push_sky_light(lane, radiance, params.env_pmf, u_light, self.throughput);
-            } else if (lambert || sampled_lanes.is_some())
+            } else if map_lanes
+                && (lambert || sampled_lanes.is_some())
                 && choice.is_none()
                 && u_light_select < params.env_pmf
                 && has_env_map(params)
@@ -578,8 +583,8 @@ pub fn trace_path(
     while path.alive {
         let hit = tracer.intersect(&path.ray, T_MAX);
         lanes.clear();
-        let mut shadow = path.step(scene, params, hit, &mut lanes, 0, true);
-        lanes.compute(scene, params);
+        let mut shadow = path.step(scene, params, hit, &mut lanes, 0, true, true);
+        lanes.compute(scene, params, true);
         if lanes.map_lights() != 0 {
             shadow = shadow.or(path.map_light_test(scene, params, &lanes, 0));
         }

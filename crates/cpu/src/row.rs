@@ -9,6 +9,7 @@ use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams};
 use crate::bsdf_lanes::{LaneBsdf, SampleLanes};
 use crate::camera::{film_point, lens_ray, primary_directions};
 use crate::cpu_scene::CpuScene;
+use crate::environment::has_env_map;
 use crate::integrator::{
     Path, ShadingLanes, ShadowTest, T_MAX, accumulated_value, add_aov_sample, add_sample,
 };
@@ -65,7 +66,7 @@ impl std::iter::Sum for Tally {
 /// compiles all of it. `MIRROR_LANES`: rough mirrors' BSDF samples side by side (at the
 /// AVX-512 level; with AVX2's 8 lanes a register they cost cornell-materials 3-4%).
 #[inline(always)]
-fn render_row<const MIRROR_LANES: bool>(
+fn render_row<const MIRROR_LANES: bool, const MAP: bool>(
     tracer: &mut Tracer,
     job: &RowJob,
     row: &mut RowSums,
@@ -102,12 +103,20 @@ fn render_row<const MIRROR_LANES: bool>(
         };
         for (l, lane) in lanes.iter_mut().enumerate() {
             if let Some((_, path)) = lane {
-                let shadow = path.step(scene, params, hits.hit(l), &mut shading, l, MIRROR_LANES);
+                let shadow = path.step(
+                    scene,
+                    params,
+                    hits.hit(l),
+                    &mut shading,
+                    l,
+                    MIRROR_LANES,
+                    MAP,
+                );
                 shadow_tests.add(l, shadow);
             }
         }
-        shading.compute(scene, params);
-        let mut left = shading.map_lights();
+        shading.compute(scene, params, MAP);
+        let mut left = if MAP { shading.map_lights() } else { 0 };
         while left != 0 {
             let l = left.trailing_zeros() as usize;
             left &= left - 1;
@@ -399,7 +408,10 @@ pub(crate) fn render_row_with(
     row: &mut RowSums,
 ) -> Tally {
     match isa {
-        InstructionSet::Baseline => render_row::<false>(tracer, job, row),
+        InstructionSet::Baseline if has_env_map(job.params) => {
+            render_row::<false, true>(tracer, job, row)
+        }
+        InstructionSet::Baseline => render_row::<false, false>(tracer, job, row),
         // SAFETY: `InstructionSet::supported` found the features on this CPU.
         #[cfg(target_arch = "x86_64")]
         InstructionSet::X86_64V3 => unsafe { render_row_x86_64_v3(tracer, job, row) },
@@ -413,7 +425,11 @@ pub(crate) fn render_row_with(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe")]
 fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
-    render_row::<false>(tracer, job, row)
+    if has_env_map(job.params) {
+        render_row::<false, true>(tracer, job, row)
+    } else {
+        render_row::<false, false>(tracer, job, row)
+    }
 }
 
 /// [`render_row`] for x86-64-v4 with GFNI.
@@ -422,5 +438,9 @@ fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) ->
     enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe,avx512f,avx512vl,avx512bw,avx512dq,avx512cd,gfni"
 )]
 fn render_row_x86_64_v4_gfni(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
-    render_row::<true>(tracer, job, row)
+    if has_env_map(job.params) {
+        render_row::<true, true>(tracer, job, row)
+    } else {
+        render_row::<true, false>(tracer, job, row)
+    }
 }
