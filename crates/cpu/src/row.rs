@@ -9,10 +9,7 @@ use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams};
 use crate::bsdf_lanes::{LaneBsdf, SampleLanes};
 use crate::camera::{film_point, lens_ray, primary_directions};
 use crate::cpu_scene::CpuScene;
-use crate::environment::has_env_map;
-use crate::integrator::{
-    Path, ShadingLanes, ShadowTest, T_MAX, accumulated_value, add_aov_sample, add_sample,
-};
+use crate::integrator::{Path, ShadingLanes, T_MAX, accumulated_value, add_aov_sample, add_sample};
 use crate::intersect::Ray;
 use crate::packet::{Lanes, PACKET, RayPacket};
 use crate::sampler::Sampler;
@@ -66,7 +63,7 @@ impl std::iter::Sum for Tally {
 /// compiles all of it. `MIRROR_LANES`: rough mirrors' BSDF samples side by side (at the
 /// AVX-512 level; with AVX2's 8 lanes a register they cost cornell-materials 3-4%).
 #[inline(always)]
-fn render_row<const MIRROR_LANES: bool, const MAP: bool>(
+fn render_row<const MIRROR_LANES: bool>(
     tracer: &mut Tracer,
     job: &RowJob,
     row: &mut RowSums,
@@ -96,46 +93,38 @@ fn render_row<const MIRROR_LANES: bool, const MAP: bool>(
         }
         let hits = tracer.intersect_packet(&packet);
         shadows.active = 0;
+        let mut unblocked = [Vec3A::ZERO; PACKET];
         shading.clear();
-        let mut shadow_tests = ShadowTests {
-            packet: &mut shadows,
-            unblocked: [Vec3A::ZERO; PACKET],
-        };
         for (l, lane) in lanes.iter_mut().enumerate() {
-            if let Some((_, path)) = lane {
-                let shadow = path.step(
-                    scene,
-                    params,
-                    hits.hit(l),
-                    &mut shading,
-                    l,
-                    MIRROR_LANES,
-                    MAP,
-                );
-                shadow_tests.add(l, shadow);
+            if let Some((_, path)) = lane
+                && let Some(shadow) =
+                    path.step(scene, params, hits.hit(l), &mut shading, l, MIRROR_LANES)
+            {
+                shadows.rays[l] = shadow.ray;
+                shadows.t_max[l] = shadow.t_max;
+                shadows.active |= 1 << l;
+                unblocked[l] = shadow.radiance;
             }
         }
-        shading.compute(scene, params, MAP);
-        let mut left = if MAP { shading.map_lights() } else { 0 };
-        while left != 0 {
-            let l = left.trailing_zeros() as usize;
-            left &= left - 1;
-            if let Some((_, path)) = &mut lanes[l] {
-                shadow_tests.add(l, path.map_light_test(scene, params, &shading, l));
+        let diffuse = &mut shading.diffuse;
+        if diffuse.mask != 0 {
+            diffuse.compute();
+            let mut left = diffuse.mask;
+            while left != 0 {
+                let l = left.trailing_zeros() as usize;
+                left &= left - 1;
+                if let Some((_, path)) = &mut lanes[l]
+                    && let Some(shadow) = path.leave_diffuse(params, diffuse, l)
+                {
+                    shadows.rays[l] = shadow.ray;
+                    shadows.t_max[l] = shadow.t_max;
+                    shadows.active |= 1 << l;
+                    unblocked[l] = shadow.radiance;
+                }
             }
         }
-        let diffuse = &shading.diffuse;
-        let mut left = diffuse.mask;
-        while left != 0 {
-            let l = left.trailing_zeros() as usize;
-            left &= left - 1;
-            if let Some((_, path)) = &mut lanes[l] {
-                shadow_tests.add(l, path.leave_diffuse(params, diffuse, l));
-            }
-        }
-        leave_sampled(&mut lanes, &shading.glass, params);
-        leave_sampled(&mut lanes, &shading.glossy, params);
-        let unblocked = shadow_tests.unblocked;
+        leave_sampled(&mut lanes, &mut shading.glass, params);
+        leave_sampled(&mut lanes, &mut shading.glossy, params);
         let blocked = tracer.occluded_packet(&shadows);
         for (l, lane) in lanes.iter_mut().enumerate() {
             let Some((x, path)) = lane else { continue };
@@ -150,38 +139,24 @@ fn render_row<const MIRROR_LANES: bool, const MAP: bool>(
     }
 }
 
-/// A round's shadow rays, and the radiance each adds unless something blocks it.
-struct ShadowTests<'a> {
-    packet: &'a mut RayPacket,
-    unblocked: [Vec3A; PACKET],
-}
-
-impl ShadowTests<'_> {
-    /// Lane `l`'s shadow test, if it has one.
-    #[inline(always)]
-    fn add(&mut self, l: usize, shadow: Option<ShadowTest>) {
-        if let Some(shadow) = shadow {
-            self.packet.rays[l] = shadow.ray;
-            self.packet.t_max[l] = shadow.t_max;
-            self.packet.active |= 1 << l;
-            self.unblocked[l] = shadow.radiance;
-        }
-    }
-}
-
-/// Goes on with the paths of `lanes` whose BSDF samples `computed` holds.
+/// Computes the BSDF samples that `waiting` holds for paths of `lanes`, and goes on with
+/// those paths.
 #[inline(always)]
 fn leave_sampled<M: LaneBsdf>(
     lanes: &mut [Option<(usize, Path)>; PACKET],
-    computed: &SampleLanes<M>,
+    waiting: &mut SampleLanes<M>,
     params: &GpuRenderParams,
 ) {
-    let mut left = computed.mask;
+    if waiting.mask == 0 {
+        return;
+    }
+    waiting.compute();
+    let mut left = waiting.mask;
     while left != 0 {
         let l = left.trailing_zeros() as usize;
         left &= left - 1;
         if let Some((_, path)) = &mut lanes[l] {
-            path.leave_sampled(params, computed, l);
+            path.leave_sampled(params, waiting, l);
         }
     }
 }
@@ -408,10 +383,7 @@ pub(crate) fn render_row_with(
     row: &mut RowSums,
 ) -> Tally {
     match isa {
-        InstructionSet::Baseline if has_env_map(job.params) => {
-            render_row::<false, true>(tracer, job, row)
-        }
-        InstructionSet::Baseline => render_row::<false, false>(tracer, job, row),
+        InstructionSet::Baseline => render_row::<false>(tracer, job, row),
         // SAFETY: `InstructionSet::supported` found the features on this CPU.
         #[cfg(target_arch = "x86_64")]
         InstructionSet::X86_64V3 => unsafe { render_row_x86_64_v3(tracer, job, row) },
@@ -425,11 +397,7 @@ pub(crate) fn render_row_with(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe")]
 fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
-    if has_env_map(job.params) {
-        render_row::<false, true>(tracer, job, row)
-    } else {
-        render_row::<false, false>(tracer, job, row)
-    }
+    render_row::<false>(tracer, job, row)
 }
 
 /// [`render_row`] for x86-64-v4 with GFNI.
@@ -438,9 +406,5 @@ fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) ->
     enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe,avx512f,avx512vl,avx512bw,avx512dq,avx512cd,gfni"
 )]
 fn render_row_x86_64_v4_gfni(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
-    if has_env_map(job.params) {
-        render_row::<true, true>(tracer, job, row)
-    } else {
-        render_row::<true, false>(tracer, job, row)
-    }
+    render_row::<true>(tracer, job, row)
 }
