@@ -7,8 +7,9 @@
 # binary and fails, naming them, when it holds a function of a module the row runs (every
 # module of pathlight-cpu but the renderer's setup in lib.rs, `cpu_scene`, `display` and the
 # level's choice in `row`), apart from `textures::alpha_stops`, the alpha test of cut-out
-# triangles, left out on purpose (rare, and large), and `Tracer::new`, which a thread calls
-# once, outside the row.
+# triangles, left out on purpose (rare, and large), `Tracer::new`, which a thread calls
+# once, outside the row, and `ShadingLanes::default`, which a row calls once, before its
+# loop.
 #
 #   tools/check-inlined.sh
 set -euo pipefail
@@ -25,7 +26,7 @@ out_of_line=$(nm -C target/release/pathlight |
     awk '$2 ~ /^[tTwW]$/ { $1 = ""; $2 = ""; sub(/^ +/, ""); print }' |
     sed 's/::h[0-9a-f]\{16\}$//' |
     grep -P "^<?pathlight_cpu::(($hot)::|row::(?!InstructionSet::|UnknownLevel |render_row_with$|render_row_x86_64_))" |
-    grep -Ev '^pathlight_cpu::(textures::alpha_stops|tracer::Tracer::new)$' |
+    grep -Ev '^<?pathlight_cpu::(textures::alpha_stops|tracer::Tracer::new|integrator::ShadingLanes as core::default::Default>::default)$' |
     sort -u || true)
 if [ -n "$out_of_line" ]; then
     echo "functions of the CPU path tracer left out of line (compiled for the baseline);" >&2

@@ -1,17 +1,18 @@
-//! The BSDF samples of the lanes of a packet whose paths stand on one kind of material of
-//! the lobes model,
-//! computed side by side: [`SampleLanes`] holds each waiting lane's vertex and runs the
-//! kind's sample ([`LaneBsdf`]: rough glass in [`crate::glass`], rough mirrors in
-//! [`crate::glossy`]) for every lane in one loop that the compiler turns into SIMD
+//! The BSDF samples, and the evaluations towards light samples, of the lanes of a packet
+//! whose paths stand on one kind of material of the lobes model, computed side by side:
+//! [`SampleLanes`] holds each waiting lane's vertex and runs the kind's sample and
+//! evaluation ([`LaneBsdf`]: rough glass in [`crate::glass`], rough mirrors in
+//! [`crate::glossy`]) for every lane in loops that the compiler turns into SIMD
 //! instructions, in place of a chain of dependent square roots and divisions per path. Each
-//! kind computes the one-path functions' values bit for bit (`sample_lobes`): the same
-//! operations in the same order, the early returns turned into a validity mask. CPU only
-//! (on the GPU, threads are lanes already).
+//! kind computes the one-path functions' values bit for bit (`sample_lobes`, `eval_lobes`):
+//! the same operations in the same order, the early returns turned into a validity mask.
+//! CPU only (on the GPU, threads are lanes already).
 
 use glam::{Vec2, Vec3A};
 
+use crate::light_sample::{INVALID as INVALID_LIGHT, LightSample};
 use crate::lobes::LobesParams;
-use crate::microfacet::{BsdfSample, INVALID};
+use crate::microfacet::{BsdfEval, BsdfSample, INVALID};
 use crate::packet::{Lanes, PACKET};
 use crate::soa::{Lanes3, at, lane, set_lane};
 
@@ -51,13 +52,37 @@ pub struct LaneSample {
     pub eta: f32,
 }
 
-/// A kind of material whose BSDF samples [`SampleLanes`] computes side by side: its
-/// parameters per lane, and one lane's sample.
+/// One lane's BSDF evaluation: what `BsdfEval` holds.
+pub struct LaneEval {
+    /// `f * |cos(wi, ns)|`.
+    pub f: [f32; 3],
+    /// The density of the whole mixture at `wi`.
+    pub pdf: f32,
+}
+
+/// A kind of material whose BSDF samples and evaluations [`SampleLanes`] computes side by
+/// side: its parameters per lane, and one lane's sample and evaluation.
 pub trait LaneBsdf: Default {
     /// Stores lane `l`'s material parameters.
     fn set(&mut self, l: usize, params: &LobesParams);
     /// Lane `l`'s sample at vertex `v`: `sample_lobes`'s bit for bit.
     fn sample(&self, l: usize, v: &LaneVertex) -> LaneSample;
+    /// Lane `l`'s evaluation at vertex `v` towards `wi`: `eval_lobes`'s bit for bit.
+    fn eval(&self, l: usize, v: &LaneVertex, wi: [f32; 3]) -> LaneEval;
+}
+
+/// A vertex's light sample with the BSDF's evaluation towards it, computed side by side:
+/// what its shadow test needs.
+#[derive(Debug, Clone, Copy)]
+pub struct LitVertex<'a> {
+    /// The light sample.
+    pub light: &'a LightSample,
+    /// The BSDF's evaluation towards it.
+    pub eval: BsdfEval,
+    /// The vertex.
+    pub position: Vec3A,
+    /// Its geometric normal (on either side: the shadow ray leaves on the light's).
+    pub ng: Vec3A,
 }
 
 /// A vertex with its BSDF sample, and what the path needs to go on from it.
@@ -95,12 +120,20 @@ pub struct SampleLanes<M> {
     u_rr: [f32; PACKET],
     /// The material parameters.
     model: M,
+    /// Bit `l` set: lane `l` has a light sample, `lights[l]`, whose direction `light_wi`
+    /// holds, waiting for the BSDF's evaluation towards it.
+    lit: Lanes,
+    lights: [LightSample; PACKET],
+    light_wi: Lanes3,
     // Outputs.
     wi: Lanes3,
     weight: Lanes3,
     pdf: [f32; PACKET],
     eta: [f32; PACKET],
     valid: [bool; PACKET],
+    /// The evaluations towards the light samples.
+    light_f: Lanes3,
+    light_pdf: [f32; PACKET],
 }
 
 impl<M: Default> Default for SampleLanes<M> {
@@ -117,11 +150,16 @@ impl<M: Default> Default for SampleLanes<M> {
             u: [[0.0; PACKET]; 2],
             u_rr: [0.0; PACKET],
             model: M::default(),
+            lit: 0,
+            lights: [INVALID_LIGHT; PACKET],
+            light_wi: zero,
             wi: zero,
             weight: zero,
             pdf: [0.0; PACKET],
             eta: [1.0; PACKET],
             valid: [false; PACKET],
+            light_f: zero,
+            light_pdf: [0.0; PACKET],
         }
     }
 }
@@ -131,6 +169,16 @@ impl<M: LaneBsdf> SampleLanes<M> {
     #[inline(always)]
     pub fn clear(&mut self) {
         self.mask = 0;
+        self.lit = 0;
+    }
+
+    /// Lane `l`, which waits or is about to ([`SampleLanes::push`]), has the valid light
+    /// sample `ls`: the BSDF is evaluated towards it too.
+    #[inline(always)]
+    pub fn push_light(&mut self, l: usize, ls: &LightSample) {
+        self.lights[l] = *ls;
+        set_lane(&mut self.light_wi, l, ls.wi);
+        self.lit |= 1 << l;
     }
 
     /// Lane `l` waits at `position`, on a material of parameters `params` and base colour
@@ -166,9 +214,10 @@ impl<M: LaneBsdf> SampleLanes<M> {
         self.mask |= 1 << l;
     }
 
-    /// Computes the waiting lanes: up to `ONE_BY_ONE` of them one after another, more
-    /// every lane side by side (those not waiting compute throw-away values; computing only
-    /// theirs, gathered into as few AVX-512 registers as they fill, was slower).
+    /// Computes the waiting lanes' samples and the evaluations towards their light samples:
+    /// up to `ONE_BY_ONE` lanes one after another, more every lane side by side (those not
+    /// waiting compute throw-away values; computing only theirs, gathered into as few
+    /// AVX-512 registers as they fill, was slower).
     #[inline(always)]
     pub fn compute(&mut self) {
         if self.mask.count_ones() <= ONE_BY_ONE {
@@ -177,26 +226,51 @@ impl<M: LaneBsdf> SampleLanes<M> {
                 let l = left.trailing_zeros() as usize;
                 left &= left - 1;
                 self.compute_lane(l);
+                if self.lit >> l & 1 != 0 {
+                    self.compute_light(l);
+                }
             }
             return;
         }
         for l in 0..PACKET {
             self.compute_lane(l);
         }
+        if self.lit != 0 {
+            for l in 0..PACKET {
+                self.compute_light(l);
+            }
+        }
     }
 
-    /// Computes lane `l`.
+    /// Lane `l`'s vertex.
     #[inline(always)]
-    fn compute_lane(&mut self, l: usize) {
-        let vertex = LaneVertex {
+    fn lane_vertex(&self, l: usize) -> LaneVertex {
+        LaneVertex {
             ns: at(&self.ns, l),
             ng: at(&self.ng, l),
             wo: at(&self.wo, l),
             color: at(&self.color, l),
             u_fresnel: self.u_fresnel[l],
             u: [self.u[0][l], self.u[1][l]],
-        };
-        let s = self.model.sample(l, &vertex);
+        }
+    }
+
+    /// Computes the evaluation towards lane `l`'s light sample.
+    #[inline(always)]
+    fn compute_light(&mut self, l: usize) {
+        let e = self
+            .model
+            .eval(l, &self.lane_vertex(l), at(&self.light_wi, l));
+        for axis in 0..3 {
+            self.light_f[axis][l] = e.f[axis];
+        }
+        self.light_pdf[l] = e.pdf;
+    }
+
+    /// Computes lane `l`'s sample.
+    #[inline(always)]
+    fn compute_lane(&mut self, l: usize) {
+        let s = self.model.sample(l, &self.lane_vertex(l));
         self.valid[l] = s.valid;
         for axis in 0..3 {
             self.wi[axis][l] = s.wi[axis];
@@ -234,12 +308,27 @@ impl<M: LaneBsdf> SampleLanes<M> {
             u_rr: self.u_rr[l],
         }
     }
+
+    /// Lane `l`'s light sample ([`SampleLanes::push_light`]), if it has one, and the
+    /// BSDF's evaluation towards it, once [`SampleLanes::compute`] ran.
+    #[inline(always)]
+    pub fn light(&self, l: usize) -> Option<LitVertex<'_>> {
+        (self.lit >> l & 1 != 0).then(|| LitVertex {
+            light: &self.lights[l],
+            eval: BsdfEval {
+                f: lane(&self.light_f, l),
+                pdf: self.light_pdf[l],
+            },
+            position: lane(&self.position, l),
+            ng: lane(&self.ng, l),
+        })
+    }
 }
 
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::lobes::sample_lobes;
+    use crate::lobes::{eval_lobes, sample_lobes};
     use crate::surface::Surface;
 
     /// Uniform numbers in [0, 1) (xorshift from `state`).
@@ -257,19 +346,21 @@ pub(crate) mod tests {
         (Vec3A::new(next(), next(), next()) * 2.0 - 1.0).normalize()
     }
 
-    /// Checks that lanes of kind `M` compute `sample_lobes`'s samples bit for bit, over 512
-    /// packets from one lane waiting to all, in any order: materials from `material` (given
-    /// the lane and the random numbers), random geometric normals, shading normals bent away
-    /// from them and next to -z (the frame's other branch), views from both sides, draws at
-    /// 0 and next to 1. Returns how many samples were invalid, and how many valid ones
-    /// `class` put in each of its two classes.
+    /// Checks that lanes of kind `M` compute `sample_lobes`'s samples bit for bit, and
+    /// `eval_lobes`'s evaluations towards light samples (two lanes in three have one: a
+    /// random direction, or the lane's own sampled one), over 512 packets from one lane
+    /// waiting to all, in any order: materials from `material` (given the lane and the
+    /// random numbers), random geometric normals, shading normals bent away from them and
+    /// next to -z (the frame's other branch), views from both sides, draws at 0 and next
+    /// to 1. Returns how many samples were invalid, how many valid ones `class` put in each
+    /// of its two classes, and how many evaluations were not zero.
     pub(crate) fn assert_lanes_as_sample_lobes<M: LaneBsdf>(
         seed: u32,
         mut material: impl FnMut(usize, &mut dyn FnMut() -> f32) -> LobesParams,
         class: impl Fn(&BsdfSample, &LobesParams) -> bool,
-    ) -> [usize; 3] {
+    ) -> [usize; 4] {
         let mut next = uniform(seed);
-        let mut outcomes = [0; 3];
+        let mut outcomes = [0; 4];
         for round in 0..512 {
             let mut lanes = SampleLanes::<M>::default();
             let mut cases = Vec::new();
@@ -301,13 +392,39 @@ pub(crate) mod tests {
                 };
                 let lane = (l * 7 + round) % PACKET;
                 lanes.push(lane, s.position, ns, ng, wo, color, m, (u_fresnel, u, 0.5));
-                cases.push((m, sample_lobes(&m, color, &s, wo, 0.5, u_fresnel, u)));
+                let sample = sample_lobes(&m, color, &s, wo, 0.5, u_fresnel, u);
+                let light = (l % 3 != 1).then(|| {
+                    let wi = if l % 2 == 0 && sample.valid {
+                        sample.wi
+                    } else {
+                        unit(&mut next)
+                    };
+                    lanes.push_light(
+                        lane,
+                        &LightSample {
+                            wi,
+                            ..INVALID_LIGHT
+                        },
+                    );
+                    (wi, eval_lobes(&m, color, &s, wo, wi))
+                });
+                cases.push((m, sample, light));
             }
             lanes.compute();
             assert_eq!(lanes.mask.count_ones() as usize, cases.len());
-            for (l, (m, theirs)) in cases.iter().enumerate() {
-                let ours = lanes.vertex((l * 7 + round) % PACKET).sample;
-                let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
+            let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
+            for (l, (m, theirs, light)) in cases.iter().enumerate() {
+                let vertex = lanes.vertex((l * 7 + round) % PACKET);
+                let ours = lanes.light((l * 7 + round) % PACKET);
+                assert_eq!(ours.is_some(), light.is_some());
+                if let (Some(ours), Some((wi, theirs))) = (ours, light) {
+                    assert_eq!(bits(ours.light.wi), bits(*wi));
+                    let ours = ours.eval;
+                    assert_eq!(bits(ours.f), bits(theirs.f), "lane {l}, round {round}");
+                    assert_eq!(ours.pdf.to_bits(), theirs.pdf.to_bits(), "lane {l}");
+                    outcomes[3] += usize::from(theirs.pdf > 0.0);
+                }
+                let ours = vertex.sample;
                 assert_eq!(ours.valid, theirs.valid, "lane {l}, round {round}");
                 if !ours.valid {
                     outcomes[0] += 1;

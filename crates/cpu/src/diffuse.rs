@@ -2,7 +2,8 @@
 //! surface (the lobes model with its Lambert lobe alone), computed side by side: each lane's
 //! BSDF sample (frame, cosine-weighted direction, validity, weight) and, where its light
 //! sample is on a quad or of a constant sky, that sample with the BSDF towards it, its
-//! multiple-importance weight and shadow ray. Written as loops over the lanes that the
+//! multiple-importance weight and shadow ray; where the sample was taken elsewhere (an
+//! environment map's), the BSDF towards it. Written as loops over the lanes that the
 //! compiler turns into SIMD instructions, they take the place of long chains of scalar
 //! square roots and divisions per path. The values are the one-path functions' bit for bit
 //! (`sample_lobes`, `sample_area_light`, `sample_environment`, `eval_lobes`,
@@ -17,10 +18,12 @@ use std::f32::consts::{FRAC_1_PI, PI};
 
 use glam::{Vec2, Vec3A};
 
+use crate::bsdf_lanes::LitVertex;
 use crate::cpu_scene::CpuScene;
 use crate::integrator::{ShadowTest, T_MAX};
 use crate::intersect::Ray;
-use crate::microfacet::{BsdfSample, INVALID};
+use crate::light_sample::{INVALID as INVALID_LIGHT, LightSample};
+use crate::microfacet::{BsdfEval, BsdfSample, INVALID};
 use crate::packet::{Lanes, PACKET};
 use crate::sampling::{power_heuristic, sin_cos_turns};
 use crate::soa::{Lanes3, dot, frame_around, lane, set_lane, to_world};
@@ -75,6 +78,12 @@ pub struct DiffuseLanes {
     emission: Lanes3,
     u_light: [[f32; PACKET]; 2],
     throughput: Lanes3,
+    /// Bit `l` set: lane `l` has a light sample taken elsewhere, `given[l]`, whose
+    /// direction `given_wi` holds, waiting for the BSDF's evaluation towards it
+    /// ([`DiffuseLanes::push_light`]).
+    given_light: Lanes,
+    given: [LightSample; PACKET],
+    given_wi: Lanes3,
     // Outputs.
     lit: [bool; PACKET],
     shadow_origin: Lanes3,
@@ -85,6 +94,9 @@ pub struct DiffuseLanes {
     weight: Lanes3,
     pdf: [f32; PACKET],
     valid: [bool; PACKET],
+    /// The evaluations towards the given light samples.
+    given_f: Lanes3,
+    given_pdf: [f32; PACKET],
 }
 
 impl Default for DiffuseLanes {
@@ -108,6 +120,9 @@ impl Default for DiffuseLanes {
             emission: zero,
             u_light: [[0.0; PACKET]; 2],
             throughput: zero,
+            given_light: 0,
+            given: [INVALID_LIGHT; PACKET],
+            given_wi: zero,
             lit: [false; PACKET],
             shadow_origin: zero,
             shadow_dir: zero,
@@ -117,6 +132,8 @@ impl Default for DiffuseLanes {
             weight: zero,
             pdf: [0.0; PACKET],
             valid: [false; PACKET],
+            given_f: zero,
+            given_pdf: [0.0; PACKET],
         }
     }
 }
@@ -136,6 +153,16 @@ impl DiffuseLanes {
         self.mask = 0;
         self.quad_light = 0;
         self.sky_light = 0;
+        self.given_light = 0;
+    }
+
+    /// Lane `l` (also [`DiffuseLanes::push`]ed) has the valid light sample `ls`, taken
+    /// elsewhere: the BSDF is evaluated towards it.
+    #[inline(always)]
+    pub fn push_light(&mut self, l: usize, ls: &LightSample) {
+        self.given[l] = *ls;
+        set_lane(&mut self.given_wi, l, ls.wi);
+        self.given_light |= 1 << l;
     }
 
     /// Lane `l` waits at `position`, whose Lambert lobe of colour `color` has shading normal
@@ -251,6 +278,21 @@ impl DiffuseLanes {
                 self.weight[axis][l] = f / pdf;
             }
             self.pdf[l] = pdf;
+        }
+        if self.given_light != 0 {
+            for l in 0..PACKET {
+                let at = |a: &Lanes3| [a[0][l], a[1][l], a[2][l]];
+                let (n, ng, wo, wi) = (at(&self.n), at(&self.ng), at(&self.wo), at(&self.given_wi));
+                // `eval_lobes` of the Lambert lobe alone, as `next_event` computes it.
+                let cos_o = dot(wo, n);
+                let cos_i = dot(wi, n);
+                let seen = dot(wi, ng) > 0.0 && cos_o > 0.0 && cos_i > 0.0;
+                for axis in 0..3 {
+                    let f = self.color[axis][l] * FRAC_1_PI * cos_i;
+                    self.given_f[axis][l] = if seen { f } else { 0.0 };
+                }
+                self.given_pdf[l] = if seen { FRAC_1_PI * cos_i } else { 0.0 };
+            }
         }
     }
 
@@ -396,6 +438,21 @@ impl DiffuseLanes {
             u_rr: self.u_rr[l],
         }
     }
+
+    /// Lane `l`'s light sample given to the lanes ([`DiffuseLanes::push_light`]), if it has
+    /// one, and the BSDF's evaluation towards it, once [`DiffuseLanes::compute`] ran.
+    #[inline(always)]
+    pub fn given_light(&self, l: usize) -> Option<LitVertex<'_>> {
+        (self.given_light >> l & 1 != 0).then(|| LitVertex {
+            light: &self.given[l],
+            eval: BsdfEval {
+                f: lane(&self.given_f, l),
+                pdf: self.given_pdf[l],
+            },
+            position: lane(&self.position, l),
+            ng: lane(&self.ng, l),
+        })
+    }
 }
 
 #[cfg(test)]
@@ -435,11 +492,12 @@ mod tests {
         Vec3A::new(next(), next(), next()) * 2.0 - 1.0
     }
 
-    /// Every lane's sample is `sample_lobes`'s for a Lambert material bit for bit: shading
-    /// normals bent away from the geometric one, both sides of the surface, normals next to
-    /// -z (the frame's other branch), and draws at 0 and next to 1. It fails with any
-    /// operation reordered (a dot product summed in another order, the frame's terms grouped
-    /// otherwise).
+    /// Every lane's sample is `sample_lobes`'s for a Lambert material bit for bit, and its
+    /// evaluation towards a light sample given to it (two lanes in three: a random direction
+    /// or the lane's own sampled one) `eval_lobes`'s: shading normals bent away from the
+    /// geometric one, both sides of the surface, normals next to -z (the frame's other
+    /// branch), and draws at 0 and next to 1. It fails with any operation reordered (a dot
+    /// product summed in another order, the frame's terms grouped otherwise).
     #[test]
     fn lanes_sample_as_sample_lobes_bit_for_bit() {
         let mut block = [Vec4::ZERO; MODEL_PARAMS];
@@ -447,7 +505,7 @@ mod tests {
         let m = LobesParams::decode(&block);
         assert!(m.is_lambert());
         let mut next = uniform(0x9e37_79b9);
-        let mut checked = [0; 2];
+        let mut checked = [0; 3];
         for round in 0..64 {
             let mut lanes = DiffuseLanes::default();
             let mut cases = Vec::new();
@@ -470,12 +528,36 @@ mod tests {
                 let side = if wo.dot(ng) >= 0.0 { 1.0 } else { -1.0 };
                 let (n, ng_side) = (ns * side, ng * side);
                 lanes.push(l, s.position, n, ng_side, wo, color, u, 0.5);
-                cases.push(sample_lobes(&m, color, &s, wo, 0.5, 0.5, u));
+                let sample = sample_lobes(&m, color, &s, wo, 0.5, 0.5, u);
+                let light = (l % 3 != 1).then(|| {
+                    let wi = if l % 2 == 0 && sample.valid {
+                        sample.wi
+                    } else {
+                        unit(r3(&mut next))
+                    };
+                    let ls = crate::light_sample::LightSample {
+                        wi,
+                        ..INVALID_LIGHT
+                    };
+                    lanes.push_light(l, &ls);
+                    (wi, eval_lobes(&m, color, &s, wo, wi))
+                });
+                cases.push((sample, light));
             }
             lanes.compute();
-            for (l, theirs) in cases.iter().enumerate() {
-                let ours = lanes.vertex(l).sample;
-                let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
+            let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
+            for (l, (theirs, light)) in cases.iter().enumerate() {
+                let vertex = lanes.vertex(l);
+                let ours = lanes.given_light(l);
+                assert_eq!(ours.is_some(), light.is_some());
+                if let (Some(ours), Some((wi, theirs))) = (ours, light) {
+                    assert_eq!(bits(ours.light.wi), bits(*wi));
+                    let ours = ours.eval;
+                    assert_eq!(bits(ours.f), bits(theirs.f), "lane {l}, round {round}");
+                    assert_eq!(ours.pdf.to_bits(), theirs.pdf.to_bits(), "lane {l}");
+                    checked[2] += usize::from(theirs.pdf > 0.0);
+                }
+                let ours = vertex.sample;
                 assert_eq!(ours.valid, theirs.valid, "lane {l}, round {round}");
                 checked[usize::from(ours.valid)] += 1;
                 if !ours.valid {
@@ -487,7 +569,7 @@ mod tests {
                 assert_eq!((ours.delta, ours.eta), (theirs.delta, theirs.eta));
             }
         }
-        // Both outcomes were met often.
+        // Both outcomes, and evaluations not zero, were met often.
         assert!(checked.iter().all(|&n| n > 200), "{checked:?}");
     }
 

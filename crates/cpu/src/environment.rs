@@ -103,17 +103,22 @@ pub fn env_escape(
     (cell_radiance(scene, params, &c), pdf)
 }
 
+/// Texel `i` of the map (row by row), decoded.
+#[inline(always)]
+fn texel(scene: &CpuScene, i: u32) -> Vec3A {
+    Vec3A::from(decode_rgb9e5(scene.env_texels[i as usize]))
+}
+
 /// The map's bilinear radiance at `c`. Twin of WGSL `cell_radiance`.
 #[inline(always)]
 pub fn cell_radiance(scene: &CpuScene, params: &GpuRenderParams, c: &MapCell) -> Vec3A {
     let w = params.env_width;
     let right = if c.column + 1 == w { 0 } else { c.column + 1 };
     let top = c.row * w;
-    let texel = |i: u32| Vec3A::from(decode_rgb9e5(scene.env_texels[i as usize]));
-    let v00 = texel(top + c.column);
-    let v10 = texel(top + right);
-    let v01 = texel(top + w + c.column);
-    let v11 = texel(top + w + right);
+    let v00 = texel(scene, top + c.column);
+    let v10 = texel(scene, top + right);
+    let v01 = texel(scene, top + w + c.column);
+    let v11 = texel(scene, top + w + right);
     let v0 = v00 * (1.0 - c.f.x) + v10 * c.f.x;
     let v1 = v01 * (1.0 - c.f.x) + v11 * c.f.x;
     (v0 * (1.0 - c.f.y) + v1 * c.f.y) * params.env_scale

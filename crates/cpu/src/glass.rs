@@ -2,11 +2,12 @@
 //! lobe alone) for [`SampleLanes`]: the visible GGX normal, the Fresnel choice between its
 //! reflection and refraction, and the mixture's evaluation there (`eval_rough_dielectric`,
 //! read twice over for its density), the longest chain of dependent square roots and
-//! divisions of any bounce. The values are the one-path functions' bit for bit
-//! (`sample_lobes` through `rough_dielectric_direction`, `eval_lobes` and
-//! `continuous_sample`), and a test holds each lane to `sample_lobes`.
+//! divisions of any bounce; and the same evaluation towards a light sample. The values are
+//! the one-path functions' bit for bit (`sample_lobes` through `rough_dielectric_direction`,
+//! `eval_lobes` and `continuous_sample`), and a test holds each lane to `sample_lobes` and
+//! `eval_lobes`.
 
-use crate::bsdf_lanes::{LaneBsdf, LaneSample, LaneVertex, SampleLanes};
+use crate::bsdf_lanes::{LaneBsdf, LaneEval, LaneSample, LaneVertex, SampleLanes};
 use crate::lobes::LobesParams;
 use crate::microfacet::fresnel_dielectric_local;
 use crate::packet::PACKET;
@@ -46,6 +47,21 @@ impl LaneBsdf for RoughGlass {
     fn sample(&self, l: usize, v: &LaneVertex) -> LaneSample {
         sample_lane(v, self.ior[l], self.alpha[l], self.tint[l])
     }
+
+    #[inline(always)]
+    fn eval(&self, l: usize, v: &LaneVertex, wi: [f32; 3]) -> LaneEval {
+        let frame = frame_around(v.ns);
+        let wo_l = to_local(&frame, v.wo);
+        eval_lane(
+            v,
+            &frame,
+            wo_l,
+            wi,
+            self.ior[l],
+            self.alpha[l],
+            self.tint[l],
+        )
+    }
 }
 
 /// `sample_lobes` of rough glass alone: `rough_dielectric_direction`, then `eval_lobes`
@@ -56,9 +72,9 @@ fn sample_lane(v: &LaneVertex, ior: f32, alpha: f32, tint: f32) -> LaneSample {
         ns,
         ng,
         wo,
-        color,
         u_fresnel,
         u,
+        ..
     } = *v;
     // `rough_dielectric_direction`.
     let frame = frame_around(ns);
@@ -83,8 +99,40 @@ fn sample_lane(v: &LaneVertex, ior: f32, alpha: f32, tint: f32) -> LaneSample {
     let sampled =
         wo_l[2] != 0.0 && (reflect || sin2_t < 1.0) && (wi_l[2] * wo_l[2] > 0.0) == reflect;
     let wi = to_world(&frame, wi_l);
-    // `eval_rough_dielectric` at `wi`.
-    let wi_l = to_local(&frame, wi);
+    let LaneEval { f, pdf } = eval_lane(v, &frame, wo_l, wi, ior, alpha, tint);
+    // `continuous_sample`.
+    let (wo_front, wi_front) = (dot(wo, ng) >= 0.0, dot(wi, ng) >= 0.0);
+    let eta = if wo_front == wi_front {
+        1.0
+    } else if wo_front {
+        ior
+    } else {
+        1.0 / ior
+    };
+    LaneSample {
+        valid: sampled && pdf > 0.0 && pdf.is_finite(),
+        wi,
+        weight: f.map(|v| v / pdf),
+        pdf,
+        eta,
+    }
+}
+
+/// `eval_lobes` of rough glass alone at `wi`, in the frame `frame` around the vertex's
+/// shading normal where `wo` is `wo_l`: `eval_rough_dielectric`, with weight 1 in the
+/// mixture's sum.
+#[inline(always)]
+fn eval_lane(
+    v: &LaneVertex,
+    frame: &[[f32; 3]; 3],
+    wo_l: [f32; 3],
+    wi: [f32; 3],
+    ior: f32,
+    alpha: f32,
+    tint: f32,
+) -> LaneEval {
+    let LaneVertex { ng, wo, color, .. } = *v;
+    let wi_l = to_local(frame, wi);
     let (cos_o, cos_i) = (wo_l[2], wi_l[2]);
     let (wo_front, wi_front) = (dot(wo, ng) >= 0.0, dot(wi, ng) >= 0.0);
     let reflect = cos_o * cos_i > 0.0;
@@ -117,22 +165,10 @@ fn sample_lane(v: &LaneVertex, ior: f32, alpha: f32, tint: f32) -> LaneSample {
         let f = color.map(|c| ((1.0 - tint) + c * tint) * ft);
         (f, pdf_m * cos_im.abs() / denom * (1.0 - fr))
     };
-    // `eval_lobes`' sum over its one lobe, and `continuous_sample`.
-    let f = f.map(|v| 0.0 + 1.0 * if seen { v } else { 0.0 });
-    let pdf = 0.0 + 1.0 * if seen { pdf } else { 0.0 };
-    let eta = if wo_front == wi_front {
-        1.0
-    } else if wo_front {
-        ior
-    } else {
-        1.0 / ior
-    };
-    LaneSample {
-        valid: sampled && pdf > 0.0 && pdf.is_finite(),
-        wi,
-        weight: f.map(|v| v / pdf),
-        pdf,
-        eta,
+    // `eval_lobes`' sum over its one lobe.
+    LaneEval {
+        f: f.map(|v| 0.0 + 1.0 * if seen { v } else { 0.0 }),
+        pdf: 0.0 + 1.0 * if seen { pdf } else { 0.0 },
     }
 }
 
@@ -144,8 +180,8 @@ mod tests {
     use crate::bsdf_lanes::tests::assert_lanes_as_sample_lobes;
     use crate::material::MODEL_PARAMS;
 
-    /// Every lane's sample is `sample_lobes`'s for rough glass alone bit for bit
-    /// (`assert_lanes_as_sample_lobes`): indices above and below 1 (thin films of air),
+    /// Every lane's sample, and its evaluation towards a light sample, are `sample_lobes`'s
+    /// and `eval_lobes`'s for rough glass alone bit for bit (`assert_lanes_as_sample_lobes`): indices above and below 1 (thin films of air),
     /// roughnesses from nearly smooth to 1, tints, Fresnel draws choosing each branch, total
     /// internal reflection. It fails with an operation regrouped (a quotient taken as a
     /// product by the reciprocal, a density's factors grouped otherwise).
@@ -166,7 +202,8 @@ mod tests {
             },
             |sample, _| sample.eta != 1.0,
         );
-        // Invalid samples, reflections and refractions were all met often.
+        // Invalid samples, reflections, refractions and evaluations not zero were all met
+        // often.
         assert!(outcomes.iter().all(|&n| n > 300), "{outcomes:?}");
     }
 }

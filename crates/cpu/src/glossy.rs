@@ -1,11 +1,12 @@
 //! The BSDF samples of paths on a rough mirror (the lobes model with its rough specular
 //! lobe alone: a conductor of complex index, or Schlick's Fresnel from the specular colour)
 //! for [`SampleLanes`]: the visible GGX normal, its reflection, and the mixture's evaluation
-//! there (the Fresnel term, D and the two G1). The values are the one-path functions' bit
-//! for bit (`sample_lobes` through `ggx_reflection`, `eval_lobes` and `continuous_sample`),
-//! and a test holds each lane to `sample_lobes`.
+//! there (the Fresnel term, D and the two G1); and the same evaluation towards a light
+//! sample. The values are the one-path functions' bit for bit (`sample_lobes` through
+//! `ggx_reflection`, `eval_lobes` and `continuous_sample`), and a test holds each lane to
+//! `sample_lobes` and `eval_lobes`.
 
-use crate::bsdf_lanes::{LaneBsdf, LaneSample, LaneVertex, SampleLanes};
+use crate::bsdf_lanes::{LaneBsdf, LaneEval, LaneSample, LaneVertex, SampleLanes};
 use crate::lobes::LobesParams;
 use crate::packet::PACKET;
 use crate::soa::{
@@ -51,14 +52,26 @@ impl LaneBsdf for RoughMirror {
 
     #[inline(always)]
     fn sample(&self, l: usize, v: &LaneVertex) -> LaneSample {
-        let fresnel = Fresnel {
+        sample_lane(v, self.alpha[l], &self.fresnel(l, v))
+    }
+
+    #[inline(always)]
+    fn eval(&self, l: usize, v: &LaneVertex, wi: [f32; 3]) -> LaneEval {
+        eval_lane(v, &side(v), wi, self.alpha[l], &self.fresnel(l, v))
+    }
+}
+
+impl RoughMirror {
+    /// Lane `l`'s Fresnel term at vertex `v`.
+    #[inline(always)]
+    fn fresnel(&self, l: usize, v: &LaneVertex) -> Fresnel {
+        Fresnel {
             conductor: self.conductor[l],
             tint: self.tint[l],
             color: v.color,
             eta: at(&self.eta, l),
             k: at(&self.k, l),
-        };
-        sample_lane(v, self.alpha[l], &fresnel)
+        }
     }
 }
 
@@ -108,24 +121,60 @@ fn specular_reflectance(f: &Fresnel, cos_i: f32) -> [f32; 3] {
     })
 }
 
+/// A vertex's normals turned to the side of `wo`, as `eval_lobes` turns them, and `wo` in
+/// the frame around the shading one.
+struct Side {
+    ng: [f32; 3],
+    n: [f32; 3],
+    frame: [[f32; 3]; 3],
+    wo_l: [f32; 3],
+}
+
+/// The side of `v`'s `wo`.
+#[inline(always)]
+fn side(v: &LaneVertex) -> Side {
+    let LaneVertex { ns, ng, wo, .. } = *v;
+    let sign = if dot(wo, ng) >= 0.0 { 1.0 } else { -1.0 };
+    let n = ns.map(|c| c * sign);
+    let frame = frame_around(n);
+    Side {
+        ng: ng.map(|c| c * sign),
+        n,
+        frame,
+        wo_l: to_local(&frame, wo),
+    }
+}
+
 /// `sample_lobes` of a rough mirror alone: `ggx_reflection`, then `eval_lobes` (the
 /// specular lobe with weight 1) and `continuous_sample` at the direction.
 #[inline(always)]
 fn sample_lane(v: &LaneVertex, alpha: f32, fresnel: &Fresnel) -> LaneSample {
-    let LaneVertex { ns, ng, wo, u, .. } = *v;
-    let sign = if dot(wo, ng) >= 0.0 { 1.0 } else { -1.0 };
-    let ng = ng.map(|c| c * sign);
-    let n = ns.map(|c| c * sign);
-    let cos_o = dot(wo, n);
+    let side = side(v);
+    let Side { n, frame, wo_l, .. } = side;
+    let cos_o = dot(v.wo, n);
     // `ggx_reflection`.
-    let frame = frame_around(n);
-    let wo_l = to_local(&frame, wo);
-    let h = ggx_sample_visible(wo_l, alpha, u);
+    let h = ggx_sample_visible(wo_l, alpha, v.u);
     let twice_cos = 2.0 * dot(wo_l, h);
     let wi_l: [f32; 3] = std::array::from_fn(|i| twice_cos * h[i] - wo_l[i]);
     let sampled = cos_o > 0.0 && wi_l[2] > 0.0;
     let wi = to_world(&frame, wi_l);
-    // `eval_lobes` at `wi`: its specular lobe, with weight 1.
+    let LaneEval { f, pdf } = eval_lane(v, &side, wi, alpha, fresnel);
+    // `continuous_sample`: a direction seen lies on the side of `wo`, so no interface is
+    // crossed.
+    LaneSample {
+        valid: sampled && pdf > 0.0 && pdf.is_finite(),
+        wi,
+        weight: f.map(|v| v / pdf),
+        pdf,
+        eta: 1.0,
+    }
+}
+
+/// `eval_lobes` of a rough mirror alone at `wi`: its specular lobe, with weight 1.
+#[inline(always)]
+fn eval_lane(v: &LaneVertex, side: &Side, wi: [f32; 3], alpha: f32, fresnel: &Fresnel) -> LaneEval {
+    let Side { ng, n, frame, wo_l } = *side;
+    let cos_o = dot(v.wo, n);
     let cos_i = dot(wi, n);
     let seen = dot(wi, ng) > 0.0 && cos_o > 0.0 && cos_i > 0.0;
     let wi_l = to_local(&frame, wi);
@@ -147,15 +196,7 @@ fn sample_lane(v: &LaneVertex, alpha: f32, fresnel: &Fresnel) -> LaneSample {
         } else {
             0.0
         };
-    // `continuous_sample`: a direction seen lies on the side of `wo`, so no interface is
-    // crossed.
-    LaneSample {
-        valid: sampled && pdf > 0.0 && pdf.is_finite(),
-        wi,
-        weight: f.map(|v| v / pdf),
-        pdf,
-        eta: 1.0,
-    }
+    LaneEval { f, pdf }
 }
 
 #[cfg(test)]
@@ -166,8 +207,8 @@ mod tests {
     use crate::bsdf_lanes::tests::assert_lanes_as_sample_lobes;
     use crate::material::MODEL_PARAMS;
 
-    /// Every lane's sample is `sample_lobes`'s for a rough mirror alone bit for bit
-    /// (`assert_lanes_as_sample_lobes`): conductors (gold, aluminium, an index with no
+    /// Every lane's sample, and its evaluation towards a light sample, are `sample_lobes`'s
+    /// and `eval_lobes`'s for a rough mirror alone bit for bit (`assert_lanes_as_sample_lobes`): conductors (gold, aluminium, an index with no
     /// absorption) and Schlick's Fresnel with any tint, roughnesses from nearly smooth to 1.
     /// It fails with any operation regrouped (a quotient taken before a product, the
     /// conductor's `eta^2 - k^2 - sin^2` summed in another order).
@@ -194,7 +235,8 @@ mod tests {
             },
             |_, m| m.conductor,
         );
-        // Invalid samples, and valid ones of both Fresnel terms, were all met often.
+        // Invalid samples, valid ones of both Fresnel terms, and evaluations not zero were all
+        // met often.
         assert!(outcomes.iter().all(|&n| n > 300), "{outcomes:?}");
     }
 }

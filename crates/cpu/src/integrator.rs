@@ -1,17 +1,17 @@
 //! Unidirectional path tracing with next-event estimation and MIS. Twin of
 //! `integrator.wgsl` (same loop, same order of sample dimensions).
 
-use glam::Vec3A;
+use glam::{Vec2, Vec3A};
 use pathlight_core::gpu_types::{
     GpuAccumPixel, GpuAovPixel, GpuRenderParams, KIND_QUAD, LIGHT_AREA, NO_LIGHT,
 };
 
-use crate::bsdf_lanes::{LaneBsdf, SampleLanes};
+use crate::bsdf_lanes::{LaneBsdf, LitVertex, SampleLanes};
 use crate::bvh::Hit;
 use crate::camera::camera_ray;
 use crate::cpu_scene::CpuScene;
 use crate::diffuse::DiffuseLanes;
-use crate::environment::{env_escape, has_env_map};
+use crate::environment::{env_escape, has_env_map, sample_environment};
 use crate::glass::GlassLanes;
 use crate::glossy::GlossyLanes;
 use crate::intersect::Ray;
@@ -21,7 +21,8 @@ use crate::material::{
     eval_material, has_continuous_material_lobe, is_lambert, lobes_params, material_absorption,
     material_albedo, material_at, sample_material,
 };
-use crate::microfacet::BsdfSample;
+use crate::microfacet::{BsdfEval, BsdfSample};
+use crate::packet::{Lanes, PACKET};
 use crate::sampler::{Draw, Sampler};
 use crate::sampling::power_heuristic;
 use crate::surface::surface_at;
@@ -85,9 +86,11 @@ pub struct ShadowTest {
 }
 
 /// The vertices of a packet's paths whose shading waits to be computed side by side, by
-/// kind of material: [`Path::step`] leaves them here, the caller computes each kind and goes
-/// on with [`Path::leave_diffuse`] and [`Path::leave_sampled`].
-#[derive(Debug, Clone, Default)]
+/// kind of material: [`Path::step`] leaves them here, the caller computes them
+/// ([`ShadingLanes::compute`]), takes the shadow tests of their environment map light
+/// samples ([`Path::map_light_test`]) and goes on with [`Path::leave_diffuse`] and
+/// [`Path::leave_sampled`].
+#[derive(Debug, Clone)]
 pub struct ShadingLanes {
     /// Purely diffuse vertices.
     pub diffuse: DiffuseLanes,
@@ -95,6 +98,25 @@ pub struct ShadingLanes {
     pub glass: GlassLanes,
     /// Rough mirror vertices (the lobes model's rough specular reflection alone).
     pub glossy: GlossyLanes,
+    /// Bit `l` set: lane `l` (a vertex of one of the kinds above) samples the environment
+    /// map at `map_u[l]`, its light sample still to be taken.
+    map_lights: Lanes,
+    map_u: [Vec2; PACKET],
+}
+
+impl Default for ShadingLanes {
+    // Out of line, and allowed so by `tools/check-inlined.sh`: a row makes its lanes once,
+    // and inlined they cost cornell-materials and lights 2-3% (the row's code generation).
+    #[inline(never)]
+    fn default() -> Self {
+        Self {
+            diffuse: DiffuseLanes::default(),
+            glass: GlassLanes::default(),
+            glossy: GlossyLanes::default(),
+            map_lights: 0,
+            map_u: [Vec2::ZERO; PACKET],
+        }
+    }
 }
 
 impl ShadingLanes {
@@ -104,6 +126,67 @@ impl ShadingLanes {
         self.diffuse.clear();
         self.glass.clear();
         self.glossy.clear();
+        self.map_lights = 0;
+    }
+
+    /// Takes the environment map's light samples left waiting
+    /// (`sample_map_lights`), then computes each kind's lanes.
+    #[inline(always)]
+    pub fn compute(&mut self, scene: &CpuScene, params: &GpuRenderParams) {
+        self.sample_map_lights(scene, params);
+        if self.diffuse.mask != 0 {
+            self.diffuse.compute();
+        }
+        if self.glass.mask != 0 {
+            self.glass.compute();
+        }
+        if self.glossy.mask != 0 {
+            self.glossy.compute();
+        }
+    }
+
+    /// Bit `l` set: lane `l` left an environment map light sample here.
+    #[inline(always)]
+    pub fn map_lights(&self) -> Lanes {
+        self.map_lights
+    }
+
+    /// Lane `l`'s environment map light sample, if it left a valid one here, with the
+    /// BSDF's evaluation towards it, once [`ShadingLanes::compute`] ran.
+    #[inline(always)]
+    fn map_light(&self, l: usize) -> Option<LitVertex<'_>> {
+        if self.diffuse.mask >> l & 1 != 0 {
+            self.diffuse.given_light(l)
+        } else if self.glass.mask >> l & 1 != 0 {
+            self.glass.light(l)
+        } else {
+            self.glossy.light(l)
+        }
+    }
+
+    /// Takes the environment map's light samples left waiting, one lane after another in a
+    /// loop of their own, so that one lane's loads from the map's megabytes of tables overlap
+    /// the next's (taken in each lane's step, they stalled it: env-sun 9-13% slower), and
+    /// gives them to their lanes' kinds to evaluate the BSDF towards.
+    #[inline(always)]
+    fn sample_map_lights(&mut self, scene: &CpuScene, params: &GpuRenderParams) {
+        let mut left = self.map_lights;
+        while left != 0 {
+            let l = left.trailing_zeros() as usize;
+            left &= left - 1;
+            // (A map's sample does not depend on the normal.)
+            let ls = sample_environment(scene, params, Vec3A::ZERO, self.map_u[l]);
+            if !ls.valid {
+                continue;
+            }
+            if self.diffuse.mask >> l & 1 != 0 {
+                self.diffuse.push_light(l, &ls);
+            } else if self.glass.mask >> l & 1 != 0 {
+                self.glass.push_light(l, &ls);
+            } else {
+                self.glossy.push_light(l, &ls);
+            }
+        }
     }
 }
 
@@ -178,7 +261,10 @@ impl Path {
     /// or a constant sky) is left to `diffuse` as lane `lane`: once
     /// [`DiffuseLanes::compute`] ran, [`Path::leave_diffuse`] goes on. On rough glass or a
     /// rough mirror (where `mirror_lanes`) the BSDF sample is left to `glass` or `glossy`
-    /// likewise, and [`Path::leave_sampled`] goes on.
+    /// likewise, and [`Path::leave_sampled`] goes on. At all such vertices a light sample of
+    /// the environment map is left to `lanes` too: [`ShadingLanes::compute`] takes it and
+    /// the kind evaluates the BSDF towards it, then [`Path::map_light_test`] gives its
+    /// shadow test.
     #[inline(always)]
     pub fn step(
         &mut self,
@@ -193,6 +279,8 @@ impl Path {
             diffuse,
             glass,
             glossy,
+            map_lights,
+            map_u,
         } = lanes;
         self.depth += 1;
         self.sample.rays += 1;
@@ -274,6 +362,15 @@ impl Path {
             (u_light_select.x, u_lobe.x, u_fresnel.x, u_rr.x);
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
         let lambert = is_lambert(material);
+        // Rough glass or a rough mirror alone: the lobe is the mixture's only one (u_lobe
+        // below its weight, 1); its sample waits for the lanes.
+        let sampled_lanes = if lambert {
+            None
+        } else {
+            lobes_params(material).filter(|m| {
+                u_lobe < 1.0 && (m.is_rough_glass() || mirror_lanes && m.is_rough_mirror())
+            })
+        };
         let mut shadow = None;
         if continuous {
             let choice = choose_light(scene, params, u_light_select);
@@ -288,6 +385,13 @@ impl Path {
             } else if sky {
                 let radiance = Vec3A::from(params.environment);
                 diffuse.push_sky_light(lane, radiance, params.env_pmf, u_light, self.throughput);
+            } else if (lambert || sampled_lanes.is_some())
+                && choice.is_none()
+                && u_light_select < params.env_pmf
+                && has_env_map(params)
+            {
+                *map_lights |= 1 << lane;
+                map_u[lane] = u_light;
             } else {
                 let ls = match choice {
                     Some((light, pmf, u_part)) => {
@@ -297,22 +401,7 @@ impl Path {
                 };
                 if ls.valid {
                     let e = eval_material(material, &s, wo, ls.wi);
-                    if e.f.max_element() > 0.0 {
-                        self.sample.rays += 1;
-                        let (ray, t_max) = shadow_ray(s.position, s.ng, &ls);
-                        let weight = if ls.mis {
-                            power_heuristic(ls.pdf, e.pdf)
-                        } else {
-                            1.0
-                        };
-                        let radiance = light_radiance(scene, params, &ls);
-                        let radiance = self.throughput * e.f * radiance * weight / ls.pdf;
-                        shadow = Some(ShadowTest {
-                            ray,
-                            t_max,
-                            radiance,
-                        });
-                    }
+                    shadow = self.shadow_test(scene, params, s.position, s.ng, &ls, &e);
                 }
             }
         }
@@ -322,21 +411,15 @@ impl Path {
             diffuse.push(lane, s.position, n, ng, wo, color, u_bsdf, u_rr);
             return shadow;
         }
-        // Rough glass or a rough mirror alone: the lobe is the mixture's only one (u_lobe
-        // below its weight, 1).
-        if let Some(m) = lobes_params(material)
-            && u_lobe < 1.0
-        {
+        if let Some(m) = sampled_lanes {
             let (position, ng, color) = (s.position, s.ng, material.base_color);
             let u = (u_fresnel, u_bsdf, u_rr);
             if m.is_rough_glass() {
                 glass.push(lane, position, s.ns, ng, wo, color, m, u);
-                return shadow;
-            }
-            if mirror_lanes && m.is_rough_mirror() {
+            } else {
                 glossy.push(lane, position, s.ns, ng, wo, color, m, u);
-                return shadow;
             }
+            return shadow;
         }
         let bs = sample_material(material, &s, wo, u_lobe, u_fresnel, u_bsdf);
         self.bounce(params, &bs, s.position, s.ng, n, u_rr);
@@ -356,9 +439,56 @@ impl Path {
         self.bounce(params, &v.sample, v.position, v.ng, v.n, v.u_rr);
     }
 
+    /// The shadow test of the environment map light sample that lane `lane` of `lanes`
+    /// left there, once [`ShadingLanes::compute`] ran and before the path leaves the vertex
+    /// (it reads the throughput that reached the vertex), as [`Path::step`] returns its own.
+    #[inline(always)]
+    pub fn map_light_test(
+        &mut self,
+        scene: &CpuScene,
+        params: &GpuRenderParams,
+        lanes: &ShadingLanes,
+        lane: usize,
+    ) -> Option<ShadowTest> {
+        let v = lanes.map_light(lane)?;
+        self.shadow_test(scene, params, v.position, v.ng, v.light, &v.eval)
+    }
+
+    /// The shadow test of the valid light sample `ls` at `position` (geometric normal
+    /// `ng`), where the BSDF's evaluation towards it is `e`; none where the BSDF passes
+    /// nothing on.
+    #[inline(always)]
+    fn shadow_test(
+        &mut self,
+        scene: &CpuScene,
+        params: &GpuRenderParams,
+        position: Vec3A,
+        ng: Vec3A,
+        ls: &LightSample,
+        e: &BsdfEval,
+    ) -> Option<ShadowTest> {
+        if e.f.max_element() > 0.0 {
+            self.sample.rays += 1;
+            let (ray, t_max) = shadow_ray(position, ng, ls);
+            let weight = if ls.mis {
+                power_heuristic(ls.pdf, e.pdf)
+            } else {
+                1.0
+            };
+            let radiance = light_radiance(scene, params, ls);
+            let radiance = self.throughput * e.f * radiance * weight / ls.pdf;
+            return Some(ShadowTest {
+                ray,
+                t_max,
+                radiance,
+            });
+        }
+        None
+    }
+
     /// Goes on from the diffuse vertex that lane `lane` of `diffuse` holds, once
-    /// [`DiffuseLanes::compute`] ran: returns the shadow test of the light sample left to it,
-    /// as [`Path::step`] returns its own.
+    /// [`DiffuseLanes::compute`] ran: returns the shadow test of the quad or sky light sample
+    /// left to it, as [`Path::step`] returns its own.
     #[inline(always)]
     pub fn leave_diffuse(
         &mut self,
@@ -449,16 +579,17 @@ pub fn trace_path(
         let hit = tracer.intersect(&path.ray, T_MAX);
         lanes.clear();
         let mut shadow = path.step(scene, params, hit, &mut lanes, 0, true);
+        lanes.compute(scene, params);
+        if lanes.map_lights() != 0 {
+            shadow = shadow.or(path.map_light_test(scene, params, &lanes, 0));
+        }
         if lanes.diffuse.mask != 0 {
-            lanes.diffuse.compute();
             shadow = shadow.or(path.leave_diffuse(params, &lanes.diffuse, 0));
         }
         if lanes.glass.mask != 0 {
-            lanes.glass.compute();
             path.leave_sampled(params, &lanes.glass, 0);
         }
         if lanes.glossy.mask != 0 {
-            lanes.glossy.compute();
             path.leave_sampled(params, &lanes.glossy, 0);
         }
         if let Some(shadow) = shadow

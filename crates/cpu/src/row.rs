@@ -9,7 +9,9 @@ use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams};
 use crate::bsdf_lanes::{LaneBsdf, SampleLanes};
 use crate::camera::{film_point, lens_ray, primary_directions};
 use crate::cpu_scene::CpuScene;
-use crate::integrator::{Path, ShadingLanes, T_MAX, accumulated_value, add_aov_sample, add_sample};
+use crate::integrator::{
+    Path, ShadingLanes, ShadowTest, T_MAX, accumulated_value, add_aov_sample, add_sample,
+};
 use crate::intersect::Ray;
 use crate::packet::{Lanes, PACKET, RayPacket};
 use crate::sampler::Sampler;
@@ -93,38 +95,38 @@ fn render_row<const MIRROR_LANES: bool>(
         }
         let hits = tracer.intersect_packet(&packet);
         shadows.active = 0;
-        let mut unblocked = [Vec3A::ZERO; PACKET];
         shading.clear();
+        let mut shadow_tests = ShadowTests {
+            packet: &mut shadows,
+            unblocked: [Vec3A::ZERO; PACKET],
+        };
         for (l, lane) in lanes.iter_mut().enumerate() {
-            if let Some((_, path)) = lane
-                && let Some(shadow) =
-                    path.step(scene, params, hits.hit(l), &mut shading, l, MIRROR_LANES)
-            {
-                shadows.rays[l] = shadow.ray;
-                shadows.t_max[l] = shadow.t_max;
-                shadows.active |= 1 << l;
-                unblocked[l] = shadow.radiance;
+            if let Some((_, path)) = lane {
+                let shadow = path.step(scene, params, hits.hit(l), &mut shading, l, MIRROR_LANES);
+                shadow_tests.add(l, shadow);
             }
         }
-        let diffuse = &mut shading.diffuse;
-        if diffuse.mask != 0 {
-            diffuse.compute();
-            let mut left = diffuse.mask;
-            while left != 0 {
-                let l = left.trailing_zeros() as usize;
-                left &= left - 1;
-                if let Some((_, path)) = &mut lanes[l]
-                    && let Some(shadow) = path.leave_diffuse(params, diffuse, l)
-                {
-                    shadows.rays[l] = shadow.ray;
-                    shadows.t_max[l] = shadow.t_max;
-                    shadows.active |= 1 << l;
-                    unblocked[l] = shadow.radiance;
-                }
+        shading.compute(scene, params);
+        let mut left = shading.map_lights();
+        while left != 0 {
+            let l = left.trailing_zeros() as usize;
+            left &= left - 1;
+            if let Some((_, path)) = &mut lanes[l] {
+                shadow_tests.add(l, path.map_light_test(scene, params, &shading, l));
             }
         }
-        leave_sampled(&mut lanes, &mut shading.glass, params);
-        leave_sampled(&mut lanes, &mut shading.glossy, params);
+        let diffuse = &shading.diffuse;
+        let mut left = diffuse.mask;
+        while left != 0 {
+            let l = left.trailing_zeros() as usize;
+            left &= left - 1;
+            if let Some((_, path)) = &mut lanes[l] {
+                shadow_tests.add(l, path.leave_diffuse(params, diffuse, l));
+            }
+        }
+        leave_sampled(&mut lanes, &shading.glass, params);
+        leave_sampled(&mut lanes, &shading.glossy, params);
+        let unblocked = shadow_tests.unblocked;
         let blocked = tracer.occluded_packet(&shadows);
         for (l, lane) in lanes.iter_mut().enumerate() {
             let Some((x, path)) = lane else { continue };
@@ -139,24 +141,38 @@ fn render_row<const MIRROR_LANES: bool>(
     }
 }
 
-/// Computes the BSDF samples that `waiting` holds for paths of `lanes`, and goes on with
-/// those paths.
+/// A round's shadow rays, and the radiance each adds unless something blocks it.
+struct ShadowTests<'a> {
+    packet: &'a mut RayPacket,
+    unblocked: [Vec3A; PACKET],
+}
+
+impl ShadowTests<'_> {
+    /// Lane `l`'s shadow test, if it has one.
+    #[inline(always)]
+    fn add(&mut self, l: usize, shadow: Option<ShadowTest>) {
+        if let Some(shadow) = shadow {
+            self.packet.rays[l] = shadow.ray;
+            self.packet.t_max[l] = shadow.t_max;
+            self.packet.active |= 1 << l;
+            self.unblocked[l] = shadow.radiance;
+        }
+    }
+}
+
+/// Goes on with the paths of `lanes` whose BSDF samples `computed` holds.
 #[inline(always)]
 fn leave_sampled<M: LaneBsdf>(
     lanes: &mut [Option<(usize, Path)>; PACKET],
-    waiting: &mut SampleLanes<M>,
+    computed: &SampleLanes<M>,
     params: &GpuRenderParams,
 ) {
-    if waiting.mask == 0 {
-        return;
-    }
-    waiting.compute();
-    let mut left = waiting.mask;
+    let mut left = computed.mask;
     while left != 0 {
         let l = left.trailing_zeros() as usize;
         left &= left - 1;
         if let Some((_, path)) = &mut lanes[l] {
-            path.leave_sampled(params, waiting, l);
+            path.leave_sampled(params, computed, l);
         }
     }
 }
