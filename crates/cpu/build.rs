@@ -1,0 +1,8 @@
+//! Rebuilds pathlight-cpu when the profile that `tools/rustc-pgo` compiles its optimised builds
+//! with changes, or the variable that chooses it.
+
+fn main() {
+    println!("cargo::rerun-if-changed=../../pgo/pathlight-cpu.profdata");
+    println!("cargo::rerun-if-changed=../../pgo/llvm-version");
+    println!("cargo::rerun-if-env-changed=PATHLIGHT_PGO");
+}
