@@ -81,18 +81,15 @@ fn render_row<const MIRROR_LANES: bool>(
     };
     let mut shadows = RayPacket::default();
     let mut shading = ShadingLanes::default();
+    // The lanes holding a path; their next rays are in `packet` (written as each went on).
+    let mut occupied: Lanes = 0;
     loop {
-        packet.active = 0;
-        for (l, lane) in lanes.iter().enumerate() {
-            if let Some((_, path)) = lane {
-                packet.rays[l] = path.ray;
-                packet.active |= 1 << l;
-            }
-        }
+        packet.active = occupied;
         tally = tally + starter.fill(&mut lanes, &mut packet, row);
         if packet.active == 0 {
             return tally;
         }
+        occupied = packet.active;
         let hits = tracer.intersect_packet(&packet);
         shadows.active = 0;
         shading.clear();
@@ -100,8 +97,11 @@ fn render_row<const MIRROR_LANES: bool>(
             packet: &mut shadows,
             unblocked: [Vec3A::ZERO; PACKET],
         };
-        for (l, lane) in lanes.iter_mut().enumerate() {
-            if let Some((_, path)) = lane {
+        let mut left = occupied;
+        while left != 0 {
+            let l = left.trailing_zeros() as usize;
+            left &= left - 1;
+            if let Some((_, path)) = &mut lanes[l] {
                 let shadow = path.step(scene, params, hits.hit(l), &mut shading, l, MIRROR_LANES);
                 shadow_tests.add(l, shadow);
             }
@@ -128,14 +128,21 @@ fn render_row<const MIRROR_LANES: bool>(
         leave_sampled(&mut lanes, &shading.glossy, params);
         let unblocked = shadow_tests.unblocked;
         let blocked = tracer.occluded_packet(&shadows);
-        for (l, lane) in lanes.iter_mut().enumerate() {
+        let mut left = occupied;
+        while left != 0 {
+            let l = left.trailing_zeros() as usize;
+            left &= left - 1;
+            let lane = &mut lanes[l];
             let Some((x, path)) = lane else { continue };
             if (shadows.active & !blocked) >> l & 1 != 0 {
                 path.add_unblocked(unblocked[l]);
             }
-            if !path.alive {
+            if path.alive {
+                packet.rays[l] = path.ray;
+            } else {
                 tally = tally + finish(path, row, *x);
                 *lane = None;
+                occupied &= !(1 << l);
             }
         }
     }
