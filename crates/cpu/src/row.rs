@@ -221,8 +221,8 @@ impl<'a> Starter<'a> {
         }
     }
 
-    /// Starts the next samples in the empty lanes of `lanes`, their camera rays into
-    /// `packet`; a path that ends at once (max_depth 0) is added to `row` and hands its lane
+    /// Starts the next samples in the lanes of `lanes` that `packet.active` leaves empty (it
+    /// marks those holding a path), their camera rays into `packet`; a path that ends at once (max_depth 0) is added to `row` and hands its lane
     /// to the next sample. Returns what those did.
     #[inline(always)]
     fn fill(
@@ -235,10 +235,10 @@ impl<'a> Starter<'a> {
         let mut tally = Tally::default();
         loop {
             let mut starting: Lanes = 0;
-            for (l, lane) in lanes.iter().enumerate() {
-                if lane.is_some() || self.next == self.count {
-                    continue;
-                }
+            let mut empty = !packet.active & Lanes::MAX >> (Lanes::BITS - PACKET as u32);
+            while empty != 0 && self.next != self.count {
+                let l = empty.trailing_zeros() as usize;
+                empty &= empty - 1;
                 let x = self.next / self.samples_per_pixel;
                 let i = job.samples.start + (self.next % self.samples_per_pixel) as u32;
                 self.next += 1;
