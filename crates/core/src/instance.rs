@@ -65,10 +65,19 @@ pub fn world_triangle(
     instances: &[GpuInstance],
     triangle: u32,
 ) -> [Vec3A; 3] {
-    let corners = triangles[triangle as usize].map(|v| Vec3A::from(vertices[v as usize].position));
+    // Not `array::map`: the CPU backend's row renderer inlines this, and a closure of
+    // `array::map` may be left out of line (compiled for the baseline instruction set).
+    let [a, b, c] = triangles[triangle as usize];
+    let corner = |v: u32| Vec3A::from(vertices[v as usize].position);
+    let corners = [corner(a), corner(b), corner(c)];
     if object.flags & FLAG_INSTANCE == 0 {
         return corners;
     }
     let instance = &instances[object.instance as usize];
-    corners.map(|p| instance.to_world_point(p))
+    let [a, b, c] = corners;
+    [
+        instance.to_world_point(a),
+        instance.to_world_point(b),
+        instance.to_world_point(c),
+    ]
 }

@@ -100,6 +100,11 @@ impl<'a> CpuScene<'a> {
     /// Triangle `i`'s three corners.
     #[inline(always)]
     pub fn corners(&self, i: u32) -> [GpuVertex; 3] {
-        self.triangles[i as usize].map(|v| self.vertices[v as usize])
+        let [a, b, c] = self.triangles[i as usize];
+        [
+            self.vertices[a as usize],
+            self.vertices[b as usize],
+            self.vertices[c as usize],
+        ]
     }
 }

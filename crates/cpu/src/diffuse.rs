@@ -366,20 +366,20 @@ impl DiffuseLanes {
         let cos_o = dot(wo, n);
         let cos_i = dot(wi, n);
         let seen = dot(wi, ng) > 0.0 && cos_o > 0.0 && cos_i > 0.0;
-        let f: [f32; 3] = std::array::from_fn(|i| {
-            if seen {
-                self.color[i][l] * FRAC_1_PI * cos_i
-            } else {
-                0.0
-            }
-        });
+        // Channel by channel, not `array::from_fn`, whose closure may be left out of line.
+        let f = if seen {
+            let c = |i: usize| self.color[i][l] * FRAC_1_PI * cos_i;
+            [c(0), c(1), c(2)]
+        } else {
+            [0.0; 3]
+        };
         let bsdf_pdf = if seen { FRAC_1_PI * cos_i } else { 0.0 };
         let lit = sampled && f[0].max(f[1]).max(f[2]) > 0.0;
         let weight = power_heuristic(pdf, bsdf_pdf);
         let eps = 1e-4 * (1.0 + p[0].abs().max(p[1].abs()).max(p[2].abs()));
-        let origin = std::array::from_fn(|i| p[i] + ng[i] * eps);
-        let unblocked =
-            std::array::from_fn(|i| self.throughput[i][l] * f[i] * radiance[i] * weight / pdf);
+        let origin = [p[0] + ng[0] * eps, p[1] + ng[1] * eps, p[2] + ng[2] * eps];
+        let unblocked = |i: usize| self.throughput[i][l] * f[i] * radiance[i] * weight / pdf;
+        let unblocked = [unblocked(0), unblocked(1), unblocked(2)];
         (lit, origin, unblocked)
     }
 

@@ -113,12 +113,21 @@ fn fresnel_conductor(cos_i: f32, eta: f32, k: f32) -> f32 {
 #[inline(always)]
 fn specular_reflectance(f: &Fresnel, cos_i: f32) -> [f32; 3] {
     let schlick = (1.0 - cos_i.clamp(0.0, 1.0)).powi(5);
-    std::array::from_fn(|i| {
-        let f0 = (1.0 - f.tint) + f.color[i] * f.tint;
-        let dielectric = f0 + (1.0 - f0) * schlick;
-        let conductor = fresnel_conductor(cos_i, f.eta[i], f.k[i]);
-        if f.conductor { conductor } else { dielectric }
-    })
+    // Channel by channel, not `array::from_fn`, whose closure may be left out of line.
+    [
+        reflectance_channel(f, cos_i, schlick, 0),
+        reflectance_channel(f, cos_i, schlick, 1),
+        reflectance_channel(f, cos_i, schlick, 2),
+    ]
+}
+
+/// Channel `i` of [`specular_reflectance`].
+#[inline(always)]
+fn reflectance_channel(f: &Fresnel, cos_i: f32, schlick: f32, i: usize) -> f32 {
+    let f0 = (1.0 - f.tint) + f.color[i] * f.tint;
+    let dielectric = f0 + (1.0 - f0) * schlick;
+    let conductor = fresnel_conductor(cos_i, f.eta[i], f.k[i]);
+    if f.conductor { conductor } else { dielectric }
 }
 
 /// A vertex's normals turned to the side of `wo`, as `eval_lobes` turns them, and `wo` in
@@ -183,13 +192,19 @@ fn eval_lane(v: &LaneVertex, side: &Side, wi: [f32; 3], alpha: f32, fresnel: &Fr
     let d = ggx_d(m, alpha);
     let g1_o = ggx_g1(wo_l, alpha);
     let g1_i = ggx_g1(wi_l, alpha);
-    let f = reflectance.map(|r| {
+    // Not `array::map`, whose closure may be left out of line.
+    let lobe = |r: f32| {
         0.0 + if seen {
             1.0 * r * d * g1_o * g1_i / (4.0 * wo_l[2])
         } else {
             0.0
         }
-    });
+    };
+    let f = [
+        lobe(reflectance[0]),
+        lobe(reflectance[1]),
+        lobe(reflectance[2]),
+    ];
     let pdf = 0.0
         + if seen {
             1.0 * g1_o * d / (4.0 * wo_l[2])

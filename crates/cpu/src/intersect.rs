@@ -216,7 +216,12 @@ pub fn intersect_triangle(
     ray: &ShearedRay,
     t_max: f32,
 ) -> (f32, f32, f32) {
-    let [p0, p1, p2] = [v0, v1, v2].map(|v| ray.in_ray_space(v));
+    // Not `array::map`: its closure may be left out of line (compiled for the baseline).
+    let [p0, p1, p2] = [
+        ray.in_ray_space(v0),
+        ray.in_ray_space(v1),
+        ray.in_ray_space(v2),
+    ];
     let e0 = difference_of_products(p1.x, p2.y, p1.y, p2.x);
     let e1 = difference_of_products(p2.x, p0.y, p2.y, p0.x);
     let e2 = difference_of_products(p0.x, p1.y, p0.y, p1.x);
