@@ -222,8 +222,9 @@ impl<'a> Starter<'a> {
     }
 
     /// Starts the next samples in the lanes of `lanes` that `packet.active` leaves empty (it
-    /// marks those holding a path), their camera rays into `packet`; a path that ends at once (max_depth 0) is added to `row` and hands its lane
-    /// to the next sample. Returns what those did.
+    /// marks those holding a path), their camera rays into `packet`; a path that ends at once
+    /// (max_depth 0) is added to `row` and hands its lane to the next sample. Returns what
+    /// those did.
     #[inline(always)]
     fn fill(
         &mut self,
