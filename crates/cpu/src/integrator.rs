@@ -555,6 +555,20 @@ impl Path {
         }
     }
 
+    /// Whether the sampler window the path's next bounce draws from is due: not computed
+    /// yet ([`Sampler::window_due`]).
+    #[inline(always)]
+    pub fn window_due(&self) -> bool {
+        self.sampler.window_due()
+    }
+
+    /// Computes the sampler windows due of `a` and `b` side by side
+    /// ([`Sampler::prepare_pair`]), for paths known to go on.
+    #[inline(always)]
+    pub fn prepare_pair(a: &mut Self, b: &mut Self) {
+        Sampler::prepare_pair(&mut a.sampler, &mut b.sampler);
+    }
+
     /// Adds the radiance of a [`ShadowTest`] whose ray nothing blocked.
     #[inline(always)]
     pub fn add_unblocked(&mut self, radiance: Vec3A) {

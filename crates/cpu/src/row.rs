@@ -62,16 +62,14 @@ impl std::iter::Sum for Tally {
 /// (pixel by pixel, each pixel's in turn) are traced as paths side by side, [`PACKET`] at a
 /// time, their rays traced together as packets; a path that ends hands its lane to the next
 /// sample. The whole path tracer is inlined here, so that each [`InstructionSet`] level
-/// compiles all of it. `MIRROR_LANES`: rough mirrors' BSDF samples side by side (at the
-/// AVX-512 level; with AVX2's 8 lanes a register they cost cornell-materials 3-4%).
+/// compiles all of it. `WIDE`: the level has AVX-512's 32 registers of sixteen lanes, worth
+/// computing rough mirrors' BSDF samples side by side (with AVX2's eight lanes they cost
+/// cornell-materials 3-4%) and two paths' sampler windows at once (with AVX2's sixteen
+/// registers they cost the furnace 7%: spilled).
 #[inline(always)]
-fn render_row<const MIRROR_LANES: bool>(
-    tracer: &mut Tracer,
-    job: &RowJob,
-    row: &mut RowSums,
-) -> Tally {
+fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
     let (scene, params) = (job.scene, job.params);
-    let mut starter = Starter::new(job, row.color.len());
+    let mut starter = Starter::new(job, row.color.len(), WIDE);
     let mut lanes: [Option<(usize, Path)>; PACKET] = std::array::from_fn(|_| None);
     let mut tally = Tally::default();
     // Reused from round to round: only the lanes in use are written.
@@ -91,6 +89,9 @@ fn render_row<const MIRROR_LANES: bool>(
         }
         occupied = packet.active;
         let hits = tracer.intersect_packet(&packet);
+        if WIDE {
+            prepare_windows(&mut lanes, hits.found() & occupied);
+        }
         shadows.active = 0;
         shading.clear();
         let mut shadow_tests = ShadowTests {
@@ -102,7 +103,7 @@ fn render_row<const MIRROR_LANES: bool>(
             let l = left.trailing_zeros() as usize;
             left &= left - 1;
             if let Some((_, path)) = &mut lanes[l] {
-                let shadow = path.step(scene, params, hits.hit(l), &mut shading, l, MIRROR_LANES);
+                let shadow = path.step(scene, params, hits.hit(l), &mut shading, l, WIDE);
                 shadow_tests.add(l, shadow);
             }
         }
@@ -144,6 +145,31 @@ fn render_row<const MIRROR_LANES: bool>(
                 *lane = None;
                 occupied &= !(1 << l);
             }
+        }
+    }
+}
+
+/// Computes the sampler windows due of the paths of `lanes` in `going_on` (those whose ray hit
+/// something: their next bounce draws from it), two paths side by side at a time; an odd one
+/// left is computed by its bounce ([`Path::step`]).
+#[inline(always)]
+fn prepare_windows(lanes: &mut [Option<(usize, Path)>; PACKET], going_on: Lanes) {
+    let mut due: Lanes = 0;
+    let mut left = going_on;
+    while left != 0 {
+        let l = left.trailing_zeros() as usize;
+        left &= left - 1;
+        if let Some((_, path)) = &lanes[l] {
+            due |= Lanes::from(path.window_due()) << l;
+        }
+    }
+    while due.count_ones() >= 2 {
+        let a = due.trailing_zeros() as usize;
+        due &= due - 1;
+        let b = due.trailing_zeros() as usize;
+        due &= due - 1;
+        if let Ok([Some((_, path_a)), Some((_, path_b))]) = lanes.get_disjoint_mut([a, b]) {
+            Path::prepare_pair(path_a, path_b);
         }
     }
 }
@@ -195,6 +221,8 @@ struct Starter<'a> {
     count: usize,
     next: usize,
     pinhole: bool,
+    /// New samplers' first windows computed two at a time ([`Sampler::prepare_pair`]).
+    paired_windows: bool,
     /// Per lane, of the sample starting there: its pixel column and sampler, its film
     /// point (for a pinhole) or camera ray (with a lens).
     starts: [(usize, Sampler); PACKET],
@@ -205,7 +233,7 @@ struct Starter<'a> {
 
 impl<'a> Starter<'a> {
     #[inline(always)]
-    fn new(job: &'a RowJob<'a>, width: usize) -> Self {
+    fn new(job: &'a RowJob<'a>, width: usize, paired_windows: bool) -> Self {
         let params = job.params;
         let samples_per_pixel = job.samples.len();
         Self {
@@ -214,6 +242,7 @@ impl<'a> Starter<'a> {
             count: width * samples_per_pixel,
             next: 0,
             pinhole: params.camera.lens_radius <= 0.0,
+            paired_windows,
             starts: std::array::from_fn(|_| (0, Sampler::new(params.sampler, 0, 0, 0))),
             film_x: [0.0; PACKET],
             film_y: [0.0; PACKET],
@@ -244,18 +273,34 @@ impl<'a> Starter<'a> {
                 let i = job.samples.start + (self.next % self.samples_per_pixel) as u32;
                 self.next += 1;
                 let pixel = job.y * params.width + x as u32;
-                let mut sampler = Sampler::new(params.sampler, pixel, i, params.seed);
-                let film = film_point(x as u32, job.y, &mut sampler);
-                if self.pinhole {
-                    (self.film_x[l], self.film_y[l]) = (film.x, film.y);
-                } else {
-                    self.lens_rays[l] = lens_ray(params, film, &mut sampler);
-                }
-                self.starts[l] = (x, sampler);
+                self.starts[l] = (x, Sampler::new(params.sampler, pixel, i, params.seed));
                 starting |= 1 << l;
             }
             if starting == 0 {
                 return tally;
+            }
+            // The new samplers' first windows two at a time (an odd one left: by its draw).
+            let mut pairs = if self.paired_windows { starting } else { 0 };
+            while pairs.count_ones() >= 2 {
+                let a = pairs.trailing_zeros() as usize;
+                pairs &= pairs - 1;
+                let b = pairs.trailing_zeros() as usize;
+                pairs &= pairs - 1;
+                if let Ok([(_, sampler_a), (_, sampler_b)]) = self.starts.get_disjoint_mut([a, b]) {
+                    Sampler::prepare_pair(sampler_a, sampler_b);
+                }
+            }
+            let mut left = starting;
+            while left != 0 {
+                let l = left.trailing_zeros() as usize;
+                left &= left - 1;
+                let (x, sampler) = &mut self.starts[l];
+                let film = film_point(*x as u32, job.y, sampler);
+                if self.pinhole {
+                    (self.film_x[l], self.film_y[l]) = (film.x, film.y);
+                } else {
+                    self.lens_rays[l] = lens_ray(params, film, sampler);
+                }
             }
             let dir = self
                 .pinhole
