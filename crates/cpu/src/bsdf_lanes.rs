@@ -10,9 +10,10 @@
 
 use glam::{Vec2, Vec3A};
 
-use crate::light_sample::{INVALID as INVALID_LIGHT, LightSample};
+use crate::light_lanes::{LightLanes, LitVertex};
+use crate::light_sample::LightSample;
 use crate::lobes::LobesParams;
-use crate::microfacet::{BsdfEval, BsdfSample, INVALID};
+use crate::microfacet::{BsdfSample, INVALID};
 use crate::packet::{Lanes, PACKET};
 use crate::soa::{Lanes3, at, lane, set_lane};
 
@@ -71,20 +72,6 @@ pub trait LaneBsdf: Default {
     fn eval(&self, l: usize, v: &LaneVertex, wi: [f32; 3]) -> LaneEval;
 }
 
-/// A vertex's light sample with the BSDF's evaluation towards it, computed side by side:
-/// what its shadow test needs.
-#[derive(Debug, Clone, Copy)]
-pub struct LitVertex<'a> {
-    /// The light sample.
-    pub light: &'a LightSample,
-    /// The BSDF's evaluation towards it.
-    pub eval: BsdfEval,
-    /// The vertex.
-    pub position: Vec3A,
-    /// Its geometric normal (on either side: the shadow ray leaves on the light's).
-    pub ng: Vec3A,
-}
-
 /// A vertex with its BSDF sample, and what the path needs to go on from it.
 #[derive(Debug, Clone, Copy)]
 pub struct SampledVertex {
@@ -120,20 +107,15 @@ pub struct SampleLanes<M> {
     u_rr: [f32; PACKET],
     /// The material parameters.
     model: M,
-    /// Bit `l` set: lane `l` has a light sample, `lights[l]`, whose direction `light_wi`
-    /// holds, waiting for the BSDF's evaluation towards it.
-    lit: Lanes,
-    lights: [LightSample; PACKET],
-    light_wi: Lanes3,
+    /// The light samples given to lanes ([`SampleLanes::push_light`]), and after `compute`
+    /// the evaluations towards them.
+    lights: LightLanes,
     // Outputs.
     wi: Lanes3,
     weight: Lanes3,
     pdf: [f32; PACKET],
     eta: [f32; PACKET],
     valid: [bool; PACKET],
-    /// The evaluations towards the light samples.
-    light_f: Lanes3,
-    light_pdf: [f32; PACKET],
 }
 
 impl<M: Default> Default for SampleLanes<M> {
@@ -150,16 +132,12 @@ impl<M: Default> Default for SampleLanes<M> {
             u: [[0.0; PACKET]; 2],
             u_rr: [0.0; PACKET],
             model: M::default(),
-            lit: 0,
-            lights: [INVALID_LIGHT; PACKET],
-            light_wi: zero,
+            lights: LightLanes::default(),
             wi: zero,
             weight: zero,
             pdf: [0.0; PACKET],
             eta: [1.0; PACKET],
             valid: [false; PACKET],
-            light_f: zero,
-            light_pdf: [0.0; PACKET],
         }
     }
 }
@@ -169,16 +147,14 @@ impl<M: LaneBsdf> SampleLanes<M> {
     #[inline(always)]
     pub fn clear(&mut self) {
         self.mask = 0;
-        self.lit = 0;
+        self.lights.clear();
     }
 
     /// Lane `l`, which waits or is about to ([`SampleLanes::push`]), has the valid light
     /// sample `ls`: the BSDF is evaluated towards it too.
     #[inline(always)]
     pub fn push_light(&mut self, l: usize, ls: &LightSample) {
-        self.lights[l] = *ls;
-        set_lane(&mut self.light_wi, l, ls.wi);
-        self.lit |= 1 << l;
+        self.lights.push(l, ls);
     }
 
     /// Lane `l` waits at `position`, on a material of parameters `params` and base colour
@@ -226,7 +202,7 @@ impl<M: LaneBsdf> SampleLanes<M> {
                 let l = left.trailing_zeros() as usize;
                 left &= left - 1;
                 self.compute_lane(l);
-                if self.lit >> l & 1 != 0 {
+                if self.lights.mask >> l & 1 != 0 {
                     self.compute_light(l);
                 }
             }
@@ -235,7 +211,7 @@ impl<M: LaneBsdf> SampleLanes<M> {
         for l in 0..PACKET {
             self.compute_lane(l);
         }
-        if self.lit != 0 {
+        if self.lights.mask != 0 {
             for l in 0..PACKET {
                 self.compute_light(l);
             }
@@ -260,11 +236,11 @@ impl<M: LaneBsdf> SampleLanes<M> {
     fn compute_light(&mut self, l: usize) {
         let e = self
             .model
-            .eval(l, &self.lane_vertex(l), at(&self.light_wi, l));
+            .eval(l, &self.lane_vertex(l), at(&self.lights.wi, l));
         for axis in 0..3 {
-            self.light_f[axis][l] = e.f[axis];
+            self.lights.f[axis][l] = e.f[axis];
         }
-        self.light_pdf[l] = e.pdf;
+        self.lights.pdf[l] = e.pdf;
     }
 
     /// Computes lane `l`'s sample.
@@ -313,21 +289,15 @@ impl<M: LaneBsdf> SampleLanes<M> {
     /// BSDF's evaluation towards it, once [`SampleLanes::compute`] ran.
     #[inline(always)]
     pub fn light(&self, l: usize) -> Option<LitVertex<'_>> {
-        (self.lit >> l & 1 != 0).then(|| LitVertex {
-            light: &self.lights[l],
-            eval: BsdfEval {
-                f: lane(&self.light_f, l),
-                pdf: self.light_pdf[l],
-            },
-            position: lane(&self.position, l),
-            ng: lane(&self.ng, l),
-        })
+        let (position, ng) = (lane(&self.position, l), lane(&self.ng, l));
+        self.lights.lit(l, position, ng)
     }
 }
 
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::light_sample::INVALID as INVALID_LIGHT;
     use crate::lobes::{eval_lobes, sample_lobes};
     use crate::surface::Surface;
 

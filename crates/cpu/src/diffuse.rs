@@ -18,12 +18,12 @@ use std::f32::consts::{FRAC_1_PI, PI};
 
 use glam::{Vec2, Vec3A};
 
-use crate::bsdf_lanes::LitVertex;
 use crate::cpu_scene::CpuScene;
 use crate::integrator::{ShadowTest, T_MAX};
 use crate::intersect::Ray;
-use crate::light_sample::{INVALID as INVALID_LIGHT, LightSample};
-use crate::microfacet::{BsdfEval, BsdfSample, INVALID};
+use crate::light_lanes::{LightLanes, LitVertex};
+use crate::light_sample::LightSample;
+use crate::microfacet::{BsdfSample, INVALID};
 use crate::packet::{Lanes, PACKET};
 use crate::sampling::{power_heuristic, sin_cos_turns};
 use crate::soa::{Lanes3, dot, frame_around, lane, set_lane, to_world};
@@ -78,12 +78,9 @@ pub struct DiffuseLanes {
     emission: Lanes3,
     u_light: [[f32; PACKET]; 2],
     throughput: Lanes3,
-    /// Bit `l` set: lane `l` has a light sample taken elsewhere, `given[l]`, whose
-    /// direction `given_wi` holds, waiting for the BSDF's evaluation towards it
-    /// ([`DiffuseLanes::push_light`]).
-    given_light: Lanes,
-    given: [LightSample; PACKET],
-    given_wi: Lanes3,
+    /// The light samples taken elsewhere, given to lanes ([`DiffuseLanes::push_light`]), and
+    /// after `compute` the evaluations towards them.
+    given: LightLanes,
     // Outputs.
     lit: [bool; PACKET],
     shadow_origin: Lanes3,
@@ -94,9 +91,6 @@ pub struct DiffuseLanes {
     weight: Lanes3,
     pdf: [f32; PACKET],
     valid: [bool; PACKET],
-    /// The evaluations towards the given light samples.
-    given_f: Lanes3,
-    given_pdf: [f32; PACKET],
 }
 
 impl Default for DiffuseLanes {
@@ -120,9 +114,7 @@ impl Default for DiffuseLanes {
             emission: zero,
             u_light: [[0.0; PACKET]; 2],
             throughput: zero,
-            given_light: 0,
-            given: [INVALID_LIGHT; PACKET],
-            given_wi: zero,
+            given: LightLanes::default(),
             lit: [false; PACKET],
             shadow_origin: zero,
             shadow_dir: zero,
@@ -132,8 +124,6 @@ impl Default for DiffuseLanes {
             weight: zero,
             pdf: [0.0; PACKET],
             valid: [false; PACKET],
-            given_f: zero,
-            given_pdf: [0.0; PACKET],
         }
     }
 }
@@ -153,16 +143,14 @@ impl DiffuseLanes {
         self.mask = 0;
         self.quad_light = 0;
         self.sky_light = 0;
-        self.given_light = 0;
+        self.given.clear();
     }
 
     /// Lane `l` (also [`DiffuseLanes::push`]ed) has the valid light sample `ls`, taken
     /// elsewhere: the BSDF is evaluated towards it.
     #[inline(always)]
     pub fn push_light(&mut self, l: usize, ls: &LightSample) {
-        self.given[l] = *ls;
-        set_lane(&mut self.given_wi, l, ls.wi);
-        self.given_light |= 1 << l;
+        self.given.push(l, ls);
     }
 
     /// Lane `l` waits at `position`, whose Lambert lobe of colour `color` has shading normal
@@ -279,19 +267,19 @@ impl DiffuseLanes {
             }
             self.pdf[l] = pdf;
         }
-        if self.given_light != 0 {
+        if self.given.mask != 0 {
             for l in 0..PACKET {
                 let at = |a: &Lanes3| [a[0][l], a[1][l], a[2][l]];
-                let (n, ng, wo, wi) = (at(&self.n), at(&self.ng), at(&self.wo), at(&self.given_wi));
+                let (n, ng, wo, wi) = (at(&self.n), at(&self.ng), at(&self.wo), at(&self.given.wi));
                 // `eval_lobes` of the Lambert lobe alone, as `next_event` computes it.
                 let cos_o = dot(wo, n);
                 let cos_i = dot(wi, n);
                 let seen = dot(wi, ng) > 0.0 && cos_o > 0.0 && cos_i > 0.0;
                 for axis in 0..3 {
                     let f = self.color[axis][l] * FRAC_1_PI * cos_i;
-                    self.given_f[axis][l] = if seen { f } else { 0.0 };
+                    self.given.f[axis][l] = if seen { f } else { 0.0 };
                 }
-                self.given_pdf[l] = if seen { FRAC_1_PI * cos_i } else { 0.0 };
+                self.given.pdf[l] = if seen { FRAC_1_PI * cos_i } else { 0.0 };
             }
         }
     }
@@ -443,15 +431,8 @@ impl DiffuseLanes {
     /// one, and the BSDF's evaluation towards it, once [`DiffuseLanes::compute`] ran.
     #[inline(always)]
     pub fn given_light(&self, l: usize) -> Option<LitVertex<'_>> {
-        (self.given_light >> l & 1 != 0).then(|| LitVertex {
-            light: &self.given[l],
-            eval: BsdfEval {
-                f: lane(&self.given_f, l),
-                pdf: self.given_pdf[l],
-            },
-            position: lane(&self.position, l),
-            ng: lane(&self.ng, l),
-        })
+        let (position, ng) = (lane(&self.position, l), lane(&self.ng, l));
+        self.given.lit(l, position, ng)
     }
 }
 
@@ -464,6 +445,7 @@ mod tests {
     use super::*;
     use crate::bsdf_lanes::tests::uniform;
     use crate::integrator::shadow_ray;
+    use crate::light_sample::INVALID as INVALID_LIGHT;
     use crate::lights::{choose_light, light_radiance, sample_light, sample_table_light};
     use crate::lobes::{LobesParams, eval_lobes, sample_lobes};
     use crate::material::MODEL_PARAMS;

@@ -6,7 +6,7 @@ use pathlight_core::gpu_types::{
     GpuAccumPixel, GpuAovPixel, GpuRenderParams, KIND_QUAD, LIGHT_AREA, NO_LIGHT,
 };
 
-use crate::bsdf_lanes::{LaneBsdf, LitVertex, SampleLanes};
+use crate::bsdf_lanes::{LaneBsdf, SampleLanes};
 use crate::bvh::Hit;
 use crate::camera::camera_ray;
 use crate::cpu_scene::CpuScene;
@@ -15,6 +15,7 @@ use crate::environment::{env_escape, has_env_map, sample_environment};
 use crate::glass::GlassLanes;
 use crate::glossy::GlossyLanes;
 use crate::intersect::Ray;
+use crate::light_lanes::LitVertex;
 use crate::light_sample::LightSample;
 use crate::lights::{choose_light, light_pdf, light_radiance, sample_light, sample_table_light};
 use crate::material::{

@@ -17,6 +17,7 @@ pub mod glass;
 pub mod glossy;
 pub mod integrator;
 pub mod intersect;
+pub mod light_lanes;
 pub mod light_sample;
 pub mod lights;
 pub mod lobes;
