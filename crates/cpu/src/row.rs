@@ -70,7 +70,9 @@ impl std::iter::Sum for Tally {
 fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
     let (scene, params) = (job.scene, job.params);
     let mut starter = Starter::new(job, row.color.len(), WIDE);
-    let mut lanes: [Option<(usize, Path)>; PACKET] = std::array::from_fn(|_| None);
+    // Each lane's path and the pixel column it adds to; `occupied` says which hold one.
+    let mut paths = std::array::repeat(starter.idle_path());
+    let mut columns = [0usize; PACKET];
     let mut tally = Tally::default();
     // Reused from round to round: only the lanes in use are written.
     let mut packet = RayPacket {
@@ -83,14 +85,14 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
     let mut occupied: Lanes = 0;
     loop {
         packet.active = occupied;
-        tally = tally + starter.fill(&mut lanes, &mut packet, row);
+        tally = tally + starter.fill(&mut paths, &mut columns, &mut packet, row);
         if packet.active == 0 {
             return tally;
         }
         occupied = packet.active;
         let hits = tracer.intersect_packet(&packet);
         if WIDE {
-            prepare_windows(&mut lanes, hits.found() & occupied);
+            prepare_windows(&mut paths, hits.found() & occupied);
         }
         shadows.active = 0;
         shading.clear();
@@ -102,73 +104,63 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
         while left != 0 {
             let l = left.trailing_zeros() as usize;
             left &= left - 1;
-            if let Some((_, path)) = &mut lanes[l] {
-                let shadow = path.step(scene, params, hits.hit(l), &mut shading, l, WIDE);
-                shadow_tests.add(l, shadow);
-            }
+            let shadow = paths[l].step(scene, params, hits.hit(l), &mut shading, l, WIDE);
+            shadow_tests.add(l, shadow);
         }
         shading.compute(scene, params);
         let mut left = shading.map_lights();
         while left != 0 {
             let l = left.trailing_zeros() as usize;
             left &= left - 1;
-            if let Some((_, path)) = &mut lanes[l] {
-                shadow_tests.add(l, path.map_light_test(scene, params, &shading, l));
-            }
+            shadow_tests.add(l, paths[l].map_light_test(scene, params, &shading, l));
         }
         let diffuse = &shading.diffuse;
         let mut left = diffuse.mask;
         while left != 0 {
             let l = left.trailing_zeros() as usize;
             left &= left - 1;
-            if let Some((_, path)) = &mut lanes[l] {
-                shadow_tests.add(l, path.leave_diffuse(params, diffuse, l));
-            }
+            shadow_tests.add(l, paths[l].leave_diffuse(params, diffuse, l));
         }
-        leave_sampled(&mut lanes, &shading.glass, params);
-        leave_sampled(&mut lanes, &shading.glossy, params);
+        leave_sampled(&mut paths, &shading.glass, params);
+        leave_sampled(&mut paths, &shading.glossy, params);
         let unblocked = shadow_tests.unblocked;
         let blocked = tracer.occluded_packet(&shadows);
         let mut left = occupied;
         while left != 0 {
             let l = left.trailing_zeros() as usize;
             left &= left - 1;
-            let lane = &mut lanes[l];
-            let Some((x, path)) = lane else { continue };
+            let path = &mut paths[l];
             if (shadows.active & !blocked) >> l & 1 != 0 {
                 path.add_unblocked(unblocked[l]);
             }
             if path.alive {
                 packet.rays[l] = path.ray;
             } else {
-                tally = tally + finish(path, row, *x);
-                *lane = None;
+                tally = tally + finish(path, row, columns[l]);
                 occupied &= !(1 << l);
             }
         }
     }
 }
 
-/// Computes the sampler windows due of the paths of `lanes` in `going_on` (those whose ray hit
+/// Computes the sampler windows due of the `paths` in `going_on` (those whose ray hit
 /// something: their next bounce draws from it), two paths side by side at a time; an odd one
 /// left is computed by its bounce ([`Path::step`]).
 #[inline(always)]
-fn prepare_windows(lanes: &mut [Option<(usize, Path)>; PACKET], going_on: Lanes) {
+fn prepare_windows(paths: &mut [Path; PACKET], going_on: Lanes) {
     let mut due: Lanes = 0;
     let mut left = going_on;
     while left != 0 {
         let l = left.trailing_zeros() as usize;
         left &= left - 1;
-        if let Some((_, path)) = &lanes[l] {
-            due |= Lanes::from(path.window_due()) << l;
-        }
+        due |= Lanes::from(paths[l].window_due()) << l;
     }
     while due.count_ones() >= 2 {
         let a = due.trailing_zeros() as usize;
         due &= due - 1;
         let b = due.trailing_zeros() as usize;
         due &= due - 1;
-        if let Ok([Some((_, path_a)), Some((_, path_b))]) = lanes.get_disjoint_mut([a, b]) {
+        if let Ok([path_a, path_b]) = paths.get_disjoint_mut([a, b]) {
             Path::prepare_pair(path_a, path_b);
         }
     }
@@ -193,10 +185,10 @@ impl ShadowTests<'_> {
     }
 }
 
-/// Goes on with the paths of `lanes` whose BSDF samples `computed` holds.
+/// Goes on with the `paths` whose BSDF samples `computed` holds.
 #[inline(always)]
 fn leave_sampled<M: LaneBsdf>(
-    lanes: &mut [Option<(usize, Path)>; PACKET],
+    paths: &mut [Path; PACKET],
     computed: &SampleLanes<M>,
     params: &GpuRenderParams,
 ) {
@@ -204,9 +196,7 @@ fn leave_sampled<M: LaneBsdf>(
     while left != 0 {
         let l = left.trailing_zeros() as usize;
         left &= left - 1;
-        if let Some((_, path)) = &mut lanes[l] {
-            path.leave_sampled(params, computed, l);
-        }
+        paths[l].leave_sampled(params, computed, l);
     }
 }
 
@@ -250,14 +240,28 @@ impl<'a> Starter<'a> {
         }
     }
 
-    /// Starts the next samples in the lanes of `lanes` that `packet.active` leaves empty (it
-    /// marks those holding a path), their camera rays into `packet`; a path that ends at once
-    /// (max_depth 0) is added to `row` and hands its lane to the next sample. Returns what
-    /// those did.
+    /// A path for a lane that holds none yet (ended: never stepped).
+    #[inline(always)]
+    fn idle_path(&self) -> Path {
+        let params = self.job.params;
+        let mut path = Path::from_camera_ray(
+            params,
+            Ray::new(params.camera.position, Vec3::Z),
+            Sampler::new(params.sampler, 0, 0, 0),
+        );
+        path.alive = false;
+        path
+    }
+
+    /// Starts the next samples in the lanes that `packet.active` leaves empty (it marks those
+    /// holding a path): their paths into `paths`, their pixel columns into `columns`, their
+    /// camera rays into `packet`; a path that ends at once (max_depth 0) is added to `row`
+    /// and hands its lane to the next sample. Returns what those did.
     #[inline(always)]
     fn fill(
         &mut self,
-        lanes: &mut [Option<(usize, Path)>; PACKET],
+        paths: &mut [Path; PACKET],
+        columns: &mut [usize; PACKET],
         packet: &mut RayPacket,
         row: &mut RowSums,
     ) -> Tally {
@@ -316,14 +320,14 @@ impl<'a> Starter<'a> {
                     ),
                     None => self.lens_rays[l],
                 };
-                let (x, sampler) = self.starts[l].clone();
-                let path = Path::from_camera_ray(params, ray, sampler);
-                if path.alive {
+                let (x, sampler) = &self.starts[l];
+                paths[l] = Path::from_camera_ray(params, ray, sampler.clone());
+                columns[l] = *x;
+                if paths[l].alive {
                     packet.rays[l] = ray;
                     packet.active |= 1 << l;
-                    lanes[l] = Some((x, path));
                 } else {
-                    tally = tally + finish(&path, row, x);
+                    tally = tally + finish(&paths[l], row, *x);
                 }
             }
             if params.max_depth > 0 {
