@@ -297,6 +297,7 @@ impl<M: LaneBsdf> SampleLanes<M> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::light_lanes::tests::assert_lit_as;
     use crate::light_sample::INVALID as INVALID_LIGHT;
     use crate::lobes::{eval_lobes, sample_lobes};
     use crate::surface::Surface;
@@ -386,14 +387,7 @@ pub(crate) mod tests {
             for (l, (m, theirs, light)) in cases.iter().enumerate() {
                 let vertex = lanes.vertex((l * 7 + round) % PACKET);
                 let ours = lanes.light((l * 7 + round) % PACKET);
-                assert_eq!(ours.is_some(), light.is_some());
-                if let (Some(ours), Some((wi, theirs))) = (ours, light) {
-                    assert_eq!(bits(ours.light.wi), bits(*wi));
-                    let ours = ours.eval;
-                    assert_eq!(bits(ours.f), bits(theirs.f), "lane {l}, round {round}");
-                    assert_eq!(ours.pdf.to_bits(), theirs.pdf.to_bits(), "lane {l}");
-                    outcomes[3] += usize::from(theirs.pdf > 0.0);
-                }
+                outcomes[3] += usize::from(assert_lit_as(ours, light.as_ref(), l, round));
                 let ours = vertex.sample;
                 assert_eq!(ours.valid, theirs.valid, "lane {l}, round {round}");
                 if !ours.valid {

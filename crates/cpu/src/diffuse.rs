@@ -445,6 +445,7 @@ mod tests {
     use super::*;
     use crate::bsdf_lanes::tests::uniform;
     use crate::integrator::shadow_ray;
+    use crate::light_lanes::tests::assert_lit_as;
     use crate::light_sample::INVALID as INVALID_LIGHT;
     use crate::lights::{choose_light, light_radiance, sample_light, sample_table_light};
     use crate::lobes::{LobesParams, eval_lobes, sample_lobes};
@@ -531,14 +532,7 @@ mod tests {
             for (l, (theirs, light)) in cases.iter().enumerate() {
                 let vertex = lanes.vertex(l);
                 let ours = lanes.given_light(l);
-                assert_eq!(ours.is_some(), light.is_some());
-                if let (Some(ours), Some((wi, theirs))) = (ours, light) {
-                    assert_eq!(bits(ours.light.wi), bits(*wi));
-                    let ours = ours.eval;
-                    assert_eq!(bits(ours.f), bits(theirs.f), "lane {l}, round {round}");
-                    assert_eq!(ours.pdf.to_bits(), theirs.pdf.to_bits(), "lane {l}");
-                    checked[2] += usize::from(theirs.pdf > 0.0);
-                }
+                checked[2] += usize::from(assert_lit_as(ours, light.as_ref(), l, round));
                 let ours = vertex.sample;
                 assert_eq!(ours.valid, theirs.valid, "lane {l}, round {round}");
                 checked[usize::from(ours.valid)] += 1;

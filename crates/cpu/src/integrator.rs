@@ -24,7 +24,7 @@ use crate::material::{
 };
 use crate::microfacet::{BsdfEval, BsdfSample};
 use crate::packet::{Lanes, PACKET};
-use crate::sampler::{Draw, Sampler};
+use crate::sampler::{BOUNCE_DRAWS, Sampler};
 use crate::sampling::power_heuristic;
 use crate::surface::surface_at;
 use crate::tracer::Tracer;
@@ -351,14 +351,8 @@ impl Path {
             return None;
         }
         // Every bounce draws the same dimensions in the same order.
-        let [u_light_select, u_light, u_lobe, u_fresnel, u_bsdf, u_rr] = self.sampler.next_batch([
-            Draw::One,
-            Draw::Two,
-            Draw::One,
-            Draw::One,
-            Draw::Two,
-            Draw::One,
-        ]);
+        let [u_light_select, u_light, u_lobe, u_fresnel, u_bsdf, u_rr] =
+            self.sampler.next_batch(BOUNCE_DRAWS);
         let (u_light_select, u_lobe, u_fresnel, u_rr) =
             (u_light_select.x, u_lobe.x, u_fresnel.x, u_rr.x);
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };

@@ -81,3 +81,32 @@ impl LightLanes {
         })
     }
 }
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use glam::Vec3A;
+
+    use super::LitVertex;
+    use crate::microfacet::BsdfEval;
+
+    /// Asserts that lane `l`'s light sample `ours`, as the lanes give it back, is the one given
+    /// to them, towards `theirs`' direction, with `theirs`' evaluation bit for bit (or that
+    /// neither exists); returns whether that evaluation's density is positive.
+    pub(crate) fn assert_lit_as(
+        ours: Option<LitVertex>,
+        theirs: Option<&(Vec3A, BsdfEval)>,
+        l: usize,
+        round: usize,
+    ) -> bool {
+        assert_eq!(ours.is_some(), theirs.is_some(), "lane {l}, round {round}");
+        let (Some(ours), Some((wi, theirs))) = (ours, theirs) else {
+            return false;
+        };
+        let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
+        assert_eq!(bits(ours.light.wi), bits(*wi), "lane {l}, round {round}");
+        let ours = ours.eval;
+        assert_eq!(bits(ours.f), bits(theirs.f), "lane {l}, round {round}");
+        assert_eq!(ours.pdf.to_bits(), theirs.pdf.to_bits(), "lane {l}");
+        theirs.pdf > 0.0
+    }
+}

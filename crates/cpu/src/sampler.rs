@@ -84,6 +84,16 @@ const LANES: usize = 8;
 /// Dimensions a bounce of the integrator draws in one batch (`Path::step`): a window of
 /// [`LANES`] values is computed anew when what is left of it cannot serve that many.
 const BOUNCE_DIMENSIONS: usize = 6;
+/// What a bounce of the integrator draws, in order (`Path::step`): the light's choice, the
+/// point on it, the lobe's choice, the Fresnel choice, the BSDF's direction, Russian roulette.
+pub const BOUNCE_DRAWS: [Draw; BOUNCE_DIMENSIONS] = [
+    Draw::One,
+    Draw::Two,
+    Draw::One,
+    Draw::One,
+    Draw::Two,
+    Draw::One,
+];
 
 /// The sample values of one path. Twin of WGSL `Sampler`.
 #[derive(Debug, Clone)]
@@ -388,7 +398,7 @@ mod tests {
         use Draw::{One, Two};
         for kind in [SAMPLER_SOBOL, SAMPLER_INDEPENDENT] {
             for skip in [0, 3, 57, 61, 70] {
-                check_batch(kind, skip, [One, Two, One, One, Two, One]);
+                check_batch(kind, skip, BOUNCE_DRAWS);
                 check_batch(kind, skip, [Two; 8]);
                 check_batch(kind, skip, [One]);
             }
@@ -400,14 +410,7 @@ mod tests {
         // Two samplers prepared side by side draw what each draws alone: fresh ones (their
         // window at dimension 0 due), ones a bounce or more along (their next window due, within
         // and beyond the hash table), and pairs where only one window is due.
-        let draws = [
-            Draw::One,
-            Draw::Two,
-            Draw::One,
-            Draw::One,
-            Draw::Two,
-            Draw::One,
-        ];
+        let draws = BOUNCE_DRAWS;
         for (skip_a, skip_b) in [(0, 0), (0, 8), (8, 14), (56, 62), (62, 80), (2, 0)] {
             let mut a = Sampler::new(SAMPLER_SOBOL, 17, 3, 9);
             let mut b = Sampler::new(SAMPLER_SOBOL, 18, 5, 9);
