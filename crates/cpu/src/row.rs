@@ -155,14 +155,22 @@ fn prepare_windows(paths: &mut [Path; PACKET], going_on: Lanes) {
         left &= left - 1;
         due |= Lanes::from(paths[l].window_due()) << l;
     }
-    while due.count_ones() >= 2 {
-        let a = due.trailing_zeros() as usize;
-        due &= due - 1;
-        let b = due.trailing_zeros() as usize;
-        due &= due - 1;
+    in_pairs(due, |a, b| {
         if let Ok([path_a, path_b]) = paths.get_disjoint_mut([a, b]) {
             Path::prepare_pair(path_a, path_b);
         }
+    });
+}
+
+/// Calls `pair` with the lanes of `lanes` two by two, lowest first (an odd one left out).
+#[inline(always)]
+fn in_pairs(mut lanes: Lanes, mut pair: impl FnMut(usize, usize)) {
+    while lanes.count_ones() >= 2 {
+        let a = lanes.trailing_zeros() as usize;
+        lanes &= lanes - 1;
+        let b = lanes.trailing_zeros() as usize;
+        lanes &= lanes - 1;
+        pair(a, b);
     }
 }
 
@@ -284,15 +292,14 @@ impl<'a> Starter<'a> {
                 return tally;
             }
             // The new samplers' first windows two at a time (an odd one left: by its draw).
-            let mut pairs = if self.paired_windows { starting } else { 0 };
-            while pairs.count_ones() >= 2 {
-                let a = pairs.trailing_zeros() as usize;
-                pairs &= pairs - 1;
-                let b = pairs.trailing_zeros() as usize;
-                pairs &= pairs - 1;
-                if let Ok([(_, sampler_a), (_, sampler_b)]) = self.starts.get_disjoint_mut([a, b]) {
-                    Sampler::prepare_pair(sampler_a, sampler_b);
-                }
+            if self.paired_windows {
+                in_pairs(starting, |a, b| {
+                    if let Ok([(_, sampler_a), (_, sampler_b)]) =
+                        self.starts.get_disjoint_mut([a, b])
+                    {
+                        Sampler::prepare_pair(sampler_a, sampler_b);
+                    }
+                });
             }
             let mut left = starting;
             while left != 0 {

@@ -106,8 +106,8 @@ pub struct Sampler {
     rng_state: u32,
     /// Sobol: the values of the [`LANES`] dimensions from `ahead_from` (both coordinates),
     /// the window [`Sampler::next_batch`] serves from, computed ahead of their use
-    /// ([`Sampler::prepare`]) so that their hash chains' latency overlaps the shading that
-    /// comes between.
+    /// ([`Sampler::prepare`], or two samplers' at once, [`Sampler::prepare_pair`]) so that
+    /// their hash chains' latency overlaps the shading that comes between.
     ahead: [Vec2; LANES],
     /// The first dimension in `ahead`.
     ahead_from: u32,
@@ -219,9 +219,10 @@ impl Sampler {
     /// `LANES` (eight) at a time side by side in SIMD lanes, into a window of values that serves
     /// the requests in turn: the camera's one or two dimensions and the first bounce's six
     /// come from one window. When what is left of the window cannot serve a bounce, the next
-    /// window is due: [`Sampler::prepare`] computes it ahead of its use once the path is
-    /// known to go on (else this does when asked), so that its latency overlaps the shading
-    /// in between and a path that ends computes none. The WGSL draws them one by one.
+    /// window is due (as is a new sampler's first, at dimension 0): [`Sampler::prepare`] or
+    /// [`Sampler::prepare_pair`] computes it ahead of its use once the path is known to go
+    /// on (else this does when asked), so that its latency overlaps the shading in between
+    /// and a path that ends computes none. The WGSL draws them one by one.
     #[inline(always)]
     pub fn next_batch<const N: usize>(&mut self, draws: [Draw; N]) -> [Vec2; N] {
         const { assert!(N <= LANES) };
