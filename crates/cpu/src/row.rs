@@ -14,7 +14,7 @@ use crate::integrator::{
 };
 use crate::intersect::Ray;
 use crate::packet::{Lanes, PACKET, RayPacket};
-use crate::sampler::Sampler;
+use crate::sampler::{PixelSamplers, Sampler};
 use crate::tracer::Tracer;
 
 /// A row's running sums: the colour's, and the auxiliary images' (empty when the render has
@@ -218,6 +218,8 @@ struct Starter<'a> {
     /// Samples in the row, and the next to start.
     count: usize,
     next: usize,
+    /// The pixel column whose samples start now, and what its samplers share.
+    pixel: (usize, PixelSamplers),
     pinhole: bool,
     /// New samplers' first windows computed two at a time ([`Sampler::prepare_pair`]).
     paired_windows: bool,
@@ -239,6 +241,10 @@ impl<'a> Starter<'a> {
             samples_per_pixel,
             count: width * samples_per_pixel,
             next: 0,
+            pixel: (
+                0,
+                PixelSamplers::new(params.sampler, job.y * params.width, params.seed),
+            ),
             pinhole: params.camera.lens_radius <= 0.0,
             paired_windows,
             starts: std::array::from_fn(|_| (0, Sampler::new(params.sampler, 0, 0, 0))),
@@ -284,8 +290,11 @@ impl<'a> Starter<'a> {
                 let x = self.next / self.samples_per_pixel;
                 let i = job.samples.start + (self.next % self.samples_per_pixel) as u32;
                 self.next += 1;
-                let pixel = job.y * params.width + x as u32;
-                self.starts[l] = (x, Sampler::new(params.sampler, pixel, i, params.seed));
+                if x != self.pixel.0 {
+                    let pixel = job.y * params.width + x as u32;
+                    self.pixel = (x, PixelSamplers::new(params.sampler, pixel, params.seed));
+                }
+                self.starts[l] = (x, self.pixel.1.sampler(i));
                 starting |= 1 << l;
             }
             if starting == 0 {

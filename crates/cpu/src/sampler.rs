@@ -116,31 +116,62 @@ pub struct Sampler {
     due: bool,
 }
 
-impl Sampler {
-    /// Sample `index` of `pixel` under `seed`, of kind `SAMPLER_*`. Twin of WGSL `sampler_init`.
+/// What the samplers of one pixel share, hashed once for all its samples (the row renderer
+/// starts a pixel's samples one after another).
+#[derive(Debug, Clone, Copy)]
+pub struct PixelSamplers {
+    kind: u32,
+    pixel: u32,
+    seed: u32,
+    /// Sobol: the hash of the pixel under the seed, which seeds every dimension's scramble.
+    pixel_seed: u32,
+}
+
+impl PixelSamplers {
+    /// The samplers of `pixel` under `seed`, of kind `SAMPLER_*`.
     #[inline(always)]
-    pub fn new(kind: u32, pixel: u32, index: u32, seed: u32) -> Self {
+    pub fn new(kind: u32, pixel: u32, seed: u32) -> Self {
         // Each kind hashes only the state it reads (WGSL hashes both).
-        let sobol = kind == SAMPLER_SOBOL;
+        let pixel_seed = if kind == SAMPLER_SOBOL {
+            pcg_hash(pixel ^ pcg_hash(seed))
+        } else {
+            0
+        };
         Self {
             kind,
-            pixel_seed: if sobol {
-                pcg_hash(pixel ^ pcg_hash(seed))
-            } else {
-                0
-            },
+            pixel,
+            seed,
+            pixel_seed,
+        }
+    }
+
+    /// The sampler of sample `index`. Twin of WGSL `sampler_init`.
+    #[inline(always)]
+    pub fn sampler(&self, index: u32) -> Sampler {
+        let sobol = self.kind == SAMPLER_SOBOL;
+        Sampler {
+            kind: self.kind,
+            pixel_seed: self.pixel_seed,
             index_reversed: index.reverse_bits(),
             dimension: 0,
             rng_state: if sobol {
                 0
             } else {
-                rng_init(pixel, index, seed)
+                rng_init(self.pixel, index, self.seed)
             },
             ahead: [Vec2::ZERO; LANES],
             // The camera's dimensions and the first bounce's come from the window at 0.
             ahead_from: 0,
             due: sobol,
         }
+    }
+}
+
+impl Sampler {
+    /// Sample `index` of `pixel` under `seed`, of kind `SAMPLER_*`. Twin of WGSL `sampler_init`.
+    #[inline(always)]
+    pub fn new(kind: u32, pixel: u32, index: u32, seed: u32) -> Self {
+        PixelSamplers::new(kind, pixel, seed).sampler(index)
     }
 
     /// Computes the window the next bounce will draw from, if due: called where the path
