@@ -201,7 +201,6 @@ pub struct Path {
     pub alive: bool,
     /// What it has brought back so far.
     pub sample: PathSample,
-    sampler: Sampler,
     depth: u32,
     throughput: Vec3A,
     /// Density of the BSDF sample that produced `ray`, and whether it came from a delta
@@ -222,17 +221,11 @@ pub struct Path {
 }
 
 impl Path {
-    /// The path of sample `sampler` through pixel (x, y): its camera ray.
+    /// The path starting on camera ray `ray`. Its sample's values come from a [`Sampler`]
+    /// kept beside it (each bounce takes it), past the dimensions the ray drew
+    /// ([`camera_ray`]'s).
     #[inline(always)]
-    pub fn new(params: &GpuRenderParams, x: u32, y: u32, mut sampler: Sampler) -> Self {
-        let ray = camera_ray(params, x, y, &mut sampler);
-        Self::from_camera_ray(params, ray, sampler)
-    }
-
-    /// The path starting on camera ray `ray`, with `sampler` past the dimensions the ray
-    /// drew ([`camera_ray`]'s).
-    #[inline(always)]
-    pub fn from_camera_ray(params: &GpuRenderParams, ray: Ray, sampler: Sampler) -> Self {
+    pub fn from_camera_ray(params: &GpuRenderParams, ray: Ray) -> Self {
         Self {
             ray,
             alive: params.max_depth > 0,
@@ -242,7 +235,6 @@ impl Path {
                 normal: Vec3A::ZERO,
                 rays: 0,
             },
-            sampler,
             depth: 0,
             throughput: Vec3A::ONE,
             prev_pdf: 0.0,
@@ -255,26 +247,27 @@ impl Path {
         }
     }
 
-    /// Goes on from `hit`, the nearest hit of [`Path::ray`]: adds what the path sees there,
+    /// Goes on from `hit`, the nearest hit of [`Path::ray`], drawing from the path's
+    /// `sampler`: adds what the path sees there,
     /// samples a light (returning its shadow ray, for the caller to trace and
     /// [`Path::add_unblocked`]) and the BSDF (the next ray), or ends the path. On a purely
     /// diffuse surface the rest of the bounce (the BSDF sample, and the light sample of a quad
     /// or a constant sky) is left to `diffuse` as lane `lane`: once
     /// [`DiffuseLanes::compute`] ran, [`Path::leave_diffuse`] goes on. On rough glass or a
-    /// rough mirror (where `mirror_lanes`) the BSDF sample is left to `glass` or `glossy`
+    /// rough mirror (with `MIRROR_LANES`) the BSDF sample is left to `glass` or `glossy`
     /// likewise, and [`Path::leave_sampled`] goes on. At all such vertices a light sample of
     /// the environment map is left to `lanes` too: [`ShadingLanes::compute`] takes it and
     /// the kind evaluates the BSDF towards it, then [`Path::map_light_test`] gives its
     /// shadow test.
     #[inline(always)]
-    pub fn step(
+    pub fn step<const MIRROR_LANES: bool>(
         &mut self,
+        sampler: &mut Sampler,
         scene: &CpuScene,
         params: &GpuRenderParams,
         hit: Option<Hit>,
         lanes: &mut ShadingLanes,
         lane: usize,
-        mirror_lanes: bool,
     ) -> Option<ShadowTest> {
         let ShadingLanes {
             diffuse,
@@ -307,7 +300,7 @@ impl Path {
             self.alive = false;
             return None;
         };
-        self.sampler.prepare();
+        sampler.prepare();
         let s = surface_at(scene, &hit, &ray);
         let material = &material_at(scene, &s);
         let wo = -Vec3A::from(ray.dir);
@@ -352,7 +345,7 @@ impl Path {
         }
         // Every bounce draws the same dimensions in the same order.
         let [u_light_select, u_light, u_lobe, u_fresnel, u_bsdf, u_rr] =
-            self.sampler.next_batch(BOUNCE_DRAWS);
+            sampler.next_batch(BOUNCE_DRAWS);
         let (u_light_select, u_lobe, u_fresnel, u_rr) =
             (u_light_select.x, u_lobe.x, u_fresnel.x, u_rr.x);
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
@@ -363,7 +356,7 @@ impl Path {
             None
         } else {
             lobes_params(material).filter(|m| {
-                u_lobe < 1.0 && (m.is_rough_glass() || mirror_lanes && m.is_rough_mirror())
+                u_lobe < 1.0 && (m.is_rough_glass() || MIRROR_LANES && m.is_rough_mirror())
             })
         };
         let mut shadow = None;
@@ -550,20 +543,6 @@ impl Path {
         }
     }
 
-    /// Whether the sampler window the path's next bounce draws from is due: not computed
-    /// yet ([`Sampler::window_due`]).
-    #[inline(always)]
-    pub fn window_due(&self) -> bool {
-        self.sampler.window_due()
-    }
-
-    /// Computes the sampler windows due of `a` and `b` side by side
-    /// ([`Sampler::prepare_pair`]), for paths known to go on.
-    #[inline(always)]
-    pub fn prepare_pair(a: &mut Self, b: &mut Self) {
-        Sampler::prepare_pair(&mut a.sampler, &mut b.sampler);
-    }
-
     /// Adds the radiance of a [`ShadowTest`] whose ray nothing blocked.
     #[inline(always)]
     pub fn add_unblocked(&mut self, radiance: Vec3A) {
@@ -580,14 +559,15 @@ pub fn trace_path(
     params: &GpuRenderParams,
     x: u32,
     y: u32,
-    sampler: Sampler,
+    mut sampler: Sampler,
 ) -> PathSample {
-    let mut path = Path::new(params, x, y, sampler);
+    let ray = camera_ray(params, x, y, &mut sampler);
+    let mut path = Path::from_camera_ray(params, ray);
     let mut lanes = ShadingLanes::default();
     while path.alive {
         let hit = tracer.intersect(&path.ray, T_MAX);
         lanes.clear();
-        let mut shadow = path.step(scene, params, hit, &mut lanes, 0, true);
+        let mut shadow = path.step::<true>(&mut sampler, scene, params, hit, &mut lanes, 0);
         lanes.compute(scene, params);
         if lanes.map_lights() != 0 {
             shadow = shadow.or(path.map_light_test(scene, params, &lanes, 0));

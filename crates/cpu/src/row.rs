@@ -70,9 +70,13 @@ impl std::iter::Sum for Tally {
 fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
     let (scene, params) = (job.scene, job.params);
     let mut starter = Starter::new(job, row.color.len(), WIDE);
-    // Each lane's path and the pixel column it adds to; `occupied` says which hold one.
-    let mut paths = std::array::repeat(starter.idle_path());
-    let mut columns = [0usize; PACKET];
+    // Each lane's path, its sampler and the pixel column it adds to; `occupied` says which
+    // hold one.
+    let mut lanes = RowLanes {
+        paths: std::array::repeat(starter.idle_path()),
+        samplers: std::array::repeat(Sampler::new(params.sampler, 0, 0, 0)),
+        columns: [0; PACKET],
+    };
     let mut tally = Tally::default();
     // Reused from round to round: only the lanes in use are written.
     let mut packet = RayPacket {
@@ -85,14 +89,19 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
     let mut occupied: Lanes = 0;
     loop {
         packet.active = occupied;
-        tally = tally + starter.fill(&mut paths, &mut columns, &mut packet, row);
+        tally = tally + starter.fill(&mut lanes, &mut packet, row);
         if packet.active == 0 {
             return tally;
         }
         occupied = packet.active;
         let hits = tracer.intersect_packet(&packet);
+        let RowLanes {
+            paths,
+            samplers,
+            columns,
+        } = &mut lanes;
         if WIDE {
-            prepare_windows(&mut paths, hits.found() & occupied);
+            prepare_windows(samplers, hits.found() & occupied);
         }
         shadows.active = 0;
         shading.clear();
@@ -104,7 +113,8 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
         while left != 0 {
             let l = left.trailing_zeros() as usize;
             left &= left - 1;
-            let shadow = paths[l].step(scene, params, hits.hit(l), &mut shading, l, WIDE);
+            let (sampler, hit) = (&mut samplers[l], hits.hit(l));
+            let shadow = paths[l].step::<WIDE>(sampler, scene, params, hit, &mut shading, l);
             shadow_tests.add(l, shadow);
         }
         shading.compute(scene, params);
@@ -121,8 +131,8 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
             left &= left - 1;
             shadow_tests.add(l, paths[l].leave_diffuse(params, diffuse, l));
         }
-        leave_sampled(&mut paths, &shading.glass, params);
-        leave_sampled(&mut paths, &shading.glossy, params);
+        leave_sampled(paths, &shading.glass, params);
+        leave_sampled(paths, &shading.glossy, params);
         let unblocked = shadow_tests.unblocked;
         let blocked = tracer.occluded_packet(&shadows);
         let mut left = occupied;
@@ -143,21 +153,28 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
     }
 }
 
-/// Computes the sampler windows due of the `paths` in `going_on` (those whose ray hit
-/// something: their next bounce draws from it), two paths side by side at a time; an odd one
-/// left is computed by its bounce ([`Path::step`]).
+/// A row's lanes: per lane a path, its sampler and the pixel column it adds to.
+struct RowLanes {
+    paths: [Path; PACKET],
+    samplers: [Sampler; PACKET],
+    columns: [usize; PACKET],
+}
+
+/// Computes the windows due of the `samplers` in `going_on` (those whose path's ray hit
+/// something: their next bounce draws from it), two side by side at a time
+/// ([`Sampler::prepare_pair`]); an odd one left is computed by its bounce ([`Path::step`]).
 #[inline(always)]
-fn prepare_windows(paths: &mut [Path; PACKET], going_on: Lanes) {
+fn prepare_windows(samplers: &mut [Sampler; PACKET], going_on: Lanes) {
     let mut due: Lanes = 0;
     let mut left = going_on;
     while left != 0 {
         let l = left.trailing_zeros() as usize;
         left &= left - 1;
-        due |= Lanes::from(paths[l].window_due()) << l;
+        due |= Lanes::from(samplers[l].window_due()) << l;
     }
     in_pairs(due, |a, b| {
-        if let Ok([path_a, path_b]) = paths.get_disjoint_mut([a, b]) {
-            Path::prepare_pair(path_a, path_b);
+        if let Ok([sampler_a, sampler_b]) = samplers.get_disjoint_mut([a, b]) {
+            Sampler::prepare_pair(sampler_a, sampler_b);
         }
     });
 }
@@ -209,23 +226,24 @@ fn leave_sampled<M: LaneBsdf>(
 }
 
 /// The samples of a row still to start (pixel by pixel, each pixel's in turn), and what
-/// starting them needs: a new path's sampler and film point are drawn lane by lane, then (for
-/// a pinhole) the camera rays of all the lanes starting at once, side by side, so that new
-/// paths do not each wait on a division and a square root.
+/// starting them needs: a new path's sampler (in its lane) and film point are drawn lane by
+/// lane, then (for a pinhole) the camera rays of all the lanes starting at once, side by side,
+/// so that new paths do not each wait on a division and a square root.
 struct Starter<'a> {
     job: &'a RowJob<'a>,
     samples_per_pixel: usize,
     /// Samples in the row, and the next to start.
     count: usize,
     next: usize,
-    /// The pixel column whose samples start now, and what its samplers share.
+    /// The pixel column whose samples start now and what its samplers share, and what the
+    /// samplers of the column before share.
     pixel: (usize, PixelSamplers),
+    previous_pixel: PixelSamplers,
     pinhole: bool,
     /// New samplers' first windows computed two at a time ([`Sampler::prepare_pair`]).
     paired_windows: bool,
-    /// Per lane, of the sample starting there: its pixel column and sampler, its film
-    /// point (for a pinhole) or camera ray (with a lens).
-    starts: [(usize, Sampler); PACKET],
+    /// Per lane, of the sample starting there: its film point (for a pinhole) or camera ray
+    /// (with a lens).
     film_x: [f32; PACKET],
     film_y: [f32; PACKET],
     lens_rays: [Ray; PACKET],
@@ -236,18 +254,16 @@ impl<'a> Starter<'a> {
     fn new(job: &'a RowJob<'a>, width: usize, paired_windows: bool) -> Self {
         let params = job.params;
         let samples_per_pixel = job.samples.len();
+        let first_pixel = PixelSamplers::new(params.sampler, job.y * params.width, params.seed);
         Self {
             job,
             samples_per_pixel,
             count: width * samples_per_pixel,
             next: 0,
-            pixel: (
-                0,
-                PixelSamplers::new(params.sampler, job.y * params.width, params.seed),
-            ),
+            pixel: (0, first_pixel),
+            previous_pixel: first_pixel,
             pinhole: params.camera.lens_radius <= 0.0,
             paired_windows,
-            starts: std::array::from_fn(|_| (0, Sampler::new(params.sampler, 0, 0, 0))),
             film_x: [0.0; PACKET],
             film_y: [0.0; PACKET],
             lens_rays: RayPacket::default().rays,
@@ -258,31 +274,22 @@ impl<'a> Starter<'a> {
     #[inline(always)]
     fn idle_path(&self) -> Path {
         let params = self.job.params;
-        let mut path = Path::from_camera_ray(
-            params,
-            Ray::new(params.camera.position, Vec3::Z),
-            Sampler::new(params.sampler, 0, 0, 0),
-        );
+        let mut path = Path::from_camera_ray(params, Ray::new(params.camera.position, Vec3::Z));
         path.alive = false;
         path
     }
 
-    /// Starts the next samples in the lanes that `packet.active` leaves empty (it marks those
-    /// holding a path): their paths into `paths`, their pixel columns into `columns`, their
-    /// camera rays into `packet`; a path that ends at once (max_depth 0) is added to `row`
-    /// and hands its lane to the next sample. Returns what those did.
+    /// Starts the next samples in the `lanes` that `packet.active` leaves empty (it marks
+    /// those holding a path), their camera rays into `packet`; a path that ends at once
+    /// (max_depth 0) is added to `row` and hands its lane to the next sample. Returns what
+    /// those did.
     #[inline(always)]
-    fn fill(
-        &mut self,
-        paths: &mut [Path; PACKET],
-        columns: &mut [usize; PACKET],
-        packet: &mut RayPacket,
-        row: &mut RowSums,
-    ) -> Tally {
+    fn fill(&mut self, lanes: &mut RowLanes, packet: &mut RayPacket, row: &mut RowSums) -> Tally {
         let (job, params) = (self.job, self.job.params);
         let mut tally = Tally::default();
         loop {
             let mut starting: Lanes = 0;
+            let mut waiting = None;
             let mut empty = !packet.active & Lanes::MAX >> (Lanes::BITS - PACKET as u32);
             while empty != 0 && self.next != self.count {
                 let l = empty.trailing_zeros() as usize;
@@ -292,30 +299,43 @@ impl<'a> Starter<'a> {
                 self.next += 1;
                 if x != self.pixel.0 {
                     let pixel = job.y * params.width + x as u32;
-                    self.pixel = (x, PixelSamplers::new(params.sampler, pixel, params.seed));
+                    let samplers = PixelSamplers::new(params.sampler, pixel, params.seed);
+                    self.previous_pixel = std::mem::replace(&mut self.pixel, (x, samplers)).1;
                 }
-                self.starts[l] = (x, self.pixel.1.sampler(i));
+                let pixel = &self.pixel.1;
+                lanes.samplers[l] = pixel.sampler(i);
+                lanes.columns[l] = x;
                 starting |= 1 << l;
+                // Its first window: where the registers are wide, with the sampler started
+                // before (of this pixel or the one before), two side by side.
+                if !self.paired_windows {
+                    lanes.samplers[l].prepare_first(pixel);
+                } else if let Some(a) = waiting.take() {
+                    let pixel_a = if lanes.columns[a] == x {
+                        pixel
+                    } else {
+                        &self.previous_pixel
+                    };
+                    if let Ok([sampler_a, sampler]) = lanes.samplers.get_disjoint_mut([a, l]) {
+                        Sampler::prepare_first_pair(sampler_a, pixel_a, sampler, pixel);
+                    }
+                } else {
+                    waiting = Some(l);
+                }
+            }
+            if let Some(a) = waiting {
+                // The last started, so of the pixel whose samples start now.
+                lanes.samplers[a].prepare_first(&self.pixel.1);
             }
             if starting == 0 {
                 return tally;
-            }
-            // The new samplers' first windows two at a time (an odd one left: by its draw).
-            if self.paired_windows {
-                in_pairs(starting, |a, b| {
-                    if let Ok([(_, sampler_a), (_, sampler_b)]) =
-                        self.starts.get_disjoint_mut([a, b])
-                    {
-                        Sampler::prepare_pair(sampler_a, sampler_b);
-                    }
-                });
             }
             let mut left = starting;
             while left != 0 {
                 let l = left.trailing_zeros() as usize;
                 left &= left - 1;
-                let (x, sampler) = &mut self.starts[l];
-                let film = film_point(*x as u32, job.y, sampler);
+                let (x, sampler) = (lanes.columns[l], &mut lanes.samplers[l]);
+                let film = film_point(x as u32, job.y, sampler);
                 if self.pinhole {
                     (self.film_x[l], self.film_y[l]) = (film.x, film.y);
                 } else {
@@ -336,14 +356,13 @@ impl<'a> Starter<'a> {
                     ),
                     None => self.lens_rays[l],
                 };
-                let (x, sampler) = &self.starts[l];
-                paths[l] = Path::from_camera_ray(params, ray, sampler.clone());
-                columns[l] = *x;
-                if paths[l].alive {
+                let path = &mut lanes.paths[l];
+                *path = Path::from_camera_ray(params, ray);
+                if path.alive {
                     packet.rays[l] = ray;
                     packet.active |= 1 << l;
                 } else {
-                    tally = tally + finish(&paths[l], row, *x);
+                    tally = tally + finish(path, row, lanes.columns[l]);
                 }
             }
             if params.max_depth > 0 {

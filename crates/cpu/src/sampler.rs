@@ -106,7 +106,8 @@ pub struct Sampler {
     rng_state: u32,
     /// Sobol: the values of the [`LANES`] dimensions from `ahead_from` (both coordinates),
     /// the window [`Sampler::next_batch`] serves from, computed ahead of their use
-    /// ([`Sampler::prepare`], or two samplers' at once, [`Sampler::prepare_pair`]) so that
+    /// ([`Sampler::prepare`], or two samplers' at once, [`Sampler::prepare_pair`]; a new
+    /// sampler's first from its pixel's seeds, [`Sampler::prepare_first`]) so that
     /// their hash chains' latency overlaps the shading that comes between.
     ahead: [Vec2; LANES],
     /// The first dimension in `ahead`.
@@ -125,45 +126,60 @@ pub struct PixelSamplers {
     seed: u32,
     /// Sobol: the hash of the pixel under the seed, which seeds every dimension's scramble.
     pixel_seed: u32,
+    /// Sobol: the scrambles' seeds of the first window's dimensions (0 to [`LANES`] - 1),
+    /// which depend on the pixel alone.
+    first_seeds: ScrambleSeeds<LANES>,
+}
+
+/// The seeds of the three Owen scrambles of `N` Sobol dimensions' values, per lane: of the
+/// shuffled index, of its x and of its y coordinate.
+#[derive(Debug, Clone, Copy)]
+struct ScrambleSeeds<const N: usize> {
+    index: [u32; N],
+    x: [u32; N],
+    y: [u32; N],
+}
+
+impl<const N: usize> ScrambleSeeds<N> {
+    /// Lane `i`'s seeds for the dimension whose hash is `dimension_hash[i]` in the pixel
+    /// whose seed is `pixel_seed[i]`.
+    #[inline(always)]
+    fn new(pixel_seed: &[u32; N], dimension_hash: &[u32; N]) -> Self {
+        let mut seeds = Self {
+            index: [0; N],
+            x: [0; N],
+            y: [0; N],
+        };
+        for i in 0..N {
+            let seed = pcg_hash(pixel_seed[i] ^ dimension_hash[i]);
+            seeds.index[i] = seed;
+            seeds.x[i] = pcg_hash(seed ^ 1);
+            seeds.y[i] = pcg_hash(seed ^ 2);
+        }
+        seeds
+    }
 }
 
 impl PixelSamplers {
     /// The samplers of `pixel` under `seed`, of kind `SAMPLER_*`.
     #[inline(always)]
     pub fn new(kind: u32, pixel: u32, seed: u32) -> Self {
-        // Each kind hashes only the state it reads (WGSL hashes both).
-        let pixel_seed = if kind == SAMPLER_SOBOL {
-            pcg_hash(pixel ^ pcg_hash(seed))
-        } else {
-            0
-        };
+        let pixel_seed = Sampler::pixel_seed(kind, pixel, seed);
+        let mut hashes = [0; LANES];
+        dimension_hashes(0, &mut hashes);
         Self {
             kind,
             pixel,
             seed,
             pixel_seed,
+            first_seeds: ScrambleSeeds::new(&[pixel_seed; LANES], &hashes),
         }
     }
 
     /// The sampler of sample `index`. Twin of WGSL `sampler_init`.
     #[inline(always)]
     pub fn sampler(&self, index: u32) -> Sampler {
-        let sobol = self.kind == SAMPLER_SOBOL;
-        Sampler {
-            kind: self.kind,
-            pixel_seed: self.pixel_seed,
-            index_reversed: index.reverse_bits(),
-            dimension: 0,
-            rng_state: if sobol {
-                0
-            } else {
-                rng_init(self.pixel, index, self.seed)
-            },
-            ahead: [Vec2::ZERO; LANES],
-            // The camera's dimensions and the first bounce's come from the window at 0.
-            ahead_from: 0,
-            due: sobol,
-        }
+        Sampler::with_pixel_seed(self.kind, self.pixel_seed, self.pixel, index, self.seed)
     }
 }
 
@@ -171,7 +187,40 @@ impl Sampler {
     /// Sample `index` of `pixel` under `seed`, of kind `SAMPLER_*`. Twin of WGSL `sampler_init`.
     #[inline(always)]
     pub fn new(kind: u32, pixel: u32, index: u32, seed: u32) -> Self {
-        PixelSamplers::new(kind, pixel, seed).sampler(index)
+        let pixel_seed = Self::pixel_seed(kind, pixel, seed);
+        Self::with_pixel_seed(kind, pixel_seed, pixel, index, seed)
+    }
+
+    /// Sobol: the seed of `pixel` under `seed` (each kind hashes only the state it reads;
+    /// WGSL hashes both).
+    #[inline(always)]
+    fn pixel_seed(kind: u32, pixel: u32, seed: u32) -> u32 {
+        if kind == SAMPLER_SOBOL {
+            pcg_hash(pixel ^ pcg_hash(seed))
+        } else {
+            0
+        }
+    }
+
+    /// [`Sampler::new`], given the pixel's seed.
+    #[inline(always)]
+    fn with_pixel_seed(kind: u32, pixel_seed: u32, pixel: u32, index: u32, seed: u32) -> Self {
+        let sobol = kind == SAMPLER_SOBOL;
+        Self {
+            kind,
+            pixel_seed,
+            index_reversed: index.reverse_bits(),
+            dimension: 0,
+            rng_state: if sobol {
+                0
+            } else {
+                rng_init(pixel, index, seed)
+            },
+            ahead: [Vec2::ZERO; LANES],
+            // The camera's dimensions and the first bounce's come from the window at 0.
+            ahead_from: 0,
+            due: sobol,
+        }
     }
 
     /// Computes the window the next bounce will draw from, if due: called where the path
@@ -183,6 +232,57 @@ impl Sampler {
             self.ahead = self.sobol_lanes(self.ahead_from);
             self.due = false;
         }
+    }
+
+    /// [`Sampler::prepare`] of a new sampler of `pixel`'s, from the scrambles' seeds it keeps.
+    #[inline(always)]
+    pub fn prepare_first(&mut self, pixel: &PixelSamplers) {
+        if self.due {
+            debug_assert_eq!(self.ahead_from, 0, "not a new sampler");
+            self.ahead = scrambled_sobol(&[self.index_reversed; LANES], &pixel.first_seeds);
+            self.due = false;
+        }
+    }
+
+    /// [`Sampler::prepare_first`] of `a`, a new sampler of `pixel_a`'s, and `b`, of
+    /// `pixel_b`'s, side by side as [`Sampler::prepare_pair`] computes them.
+    #[inline(always)]
+    pub fn prepare_first_pair(
+        a: &mut Self,
+        pixel_a: &PixelSamplers,
+        b: &mut Self,
+        pixel_b: &PixelSamplers,
+    ) {
+        if !(a.due && b.due) {
+            a.prepare_first(pixel_a);
+            b.prepare_first(pixel_b);
+            return;
+        }
+        debug_assert!(a.ahead_from == 0 && b.ahead_from == 0, "not new samplers");
+        let mut index_reversed = [a.index_reversed; 2 * LANES];
+        let mut seeds = ScrambleSeeds {
+            index: [0; 2 * LANES],
+            x: [0; 2 * LANES],
+            y: [0; 2 * LANES],
+        };
+        for (half, pixel) in [(0, pixel_a), (LANES, pixel_b)] {
+            let lanes = half..half + LANES;
+            seeds.index[lanes.clone()].copy_from_slice(&pixel.first_seeds.index);
+            seeds.x[lanes.clone()].copy_from_slice(&pixel.first_seeds.x);
+            seeds.y[lanes].copy_from_slice(&pixel.first_seeds.y);
+        }
+        index_reversed[LANES..].fill(b.index_reversed);
+        a.take_pair_half(b, &scrambled_sobol(&index_reversed, &seeds));
+    }
+
+    /// Takes the window of `a` (`self`) from the first half of `values`, `b`'s from the
+    /// second.
+    #[inline(always)]
+    fn take_pair_half(&mut self, b: &mut Self, values: &[Vec2; 2 * LANES]) {
+        self.ahead.copy_from_slice(&values[..LANES]);
+        b.ahead.copy_from_slice(&values[LANES..]);
+        self.due = false;
+        b.due = false;
     }
 
     /// Whether the window the next request draws from is due ([`Sampler::prepare`] would
@@ -212,11 +312,8 @@ impl Sampler {
             pixel_seed[i] = b.pixel_seed;
             index_reversed[i] = b.index_reversed;
         }
-        let values = scrambled_sobol(&pixel_seed, &index_reversed, &hashes);
-        a.ahead.copy_from_slice(&values[..LANES]);
-        b.ahead.copy_from_slice(&values[LANES..]);
-        a.due = false;
-        b.due = false;
+        let seeds = ScrambleSeeds::new(&pixel_seed, &hashes);
+        a.take_pair_half(b, &scrambled_sobol(&index_reversed, &seeds));
     }
 
     fn next_random(&mut self) -> f32 {
@@ -298,11 +395,8 @@ impl Sampler {
         // faster on a bounce's six than six lanes.
         let mut hashes = [0u32; LANES];
         dimension_hashes(first, &mut hashes);
-        scrambled_sobol(
-            &[self.pixel_seed; LANES],
-            &[self.index_reversed; LANES],
-            &hashes,
-        )
+        let seeds = ScrambleSeeds::new(&[self.pixel_seed; LANES], &hashes);
+        scrambled_sobol(&[self.index_reversed; LANES], &seeds)
     }
 }
 
@@ -319,21 +413,19 @@ fn dimension_hashes(first: u32, hashes: &mut [u32]) {
     }
 }
 
-/// Both coordinates of `N` Sobol values side by side, lane `i` of the sample whose pixel
-/// seed and reversed index are `pixel_seed[i]` and `index_reversed[i]`, in the dimension
-/// whose hash is `dimension_hash[i]`.
+/// Both coordinates of `N` Sobol values side by side, lane `i` of the sample whose reversed
+/// index is `index_reversed[i]`, in the dimension (of its pixel) whose scrambles' seeds are
+/// lane `i` of `seeds`.
 #[inline(always)]
 fn scrambled_sobol<const N: usize>(
-    pixel_seed: &[u32; N],
     index_reversed: &[u32; N],
-    dimension_hash: &[u32; N],
+    seeds: &ScrambleSeeds<N>,
 ) -> [Vec2; N] {
     let (mut x, mut y) = ([0u32; N], [0u32; N]);
     for i in 0..N {
-        let seed = pcg_hash(pixel_seed[i] ^ dimension_hash[i]);
-        let index = owen_scramble_reversed(index_reversed[i], seed);
-        x[i] = owen_scramble_reversed(index, pcg_hash(seed ^ 1));
-        y[i] = owen_scramble_reversed(sobol_1_reversed(index), pcg_hash(seed ^ 2));
+        let index = owen_scramble_reversed(index_reversed[i], seeds.index[i]);
+        x[i] = owen_scramble_reversed(index, seeds.x[i]);
+        y[i] = owen_scramble_reversed(sobol_1_reversed(index), seeds.y[i]);
     }
     let mut values = [Vec2::ZERO; N];
     for i in 0..N {
@@ -457,6 +549,34 @@ mod tests {
             for _ in 0..3 {
                 assert_eq!(a.next_batch(draws), alone_a.next_batch(draws), "{skip_a}");
                 assert_eq!(b.next_batch(draws), alone_b.next_batch(draws), "{skip_b}");
+            }
+        }
+    }
+
+    #[test]
+    fn first_windows_from_the_pixels_seeds_draw_what_new_samplers_draw() {
+        // A pixel's samplers, their first windows computed from the scrambles' seeds it
+        // keeps (alone, or two side by side of the same or of two pixels), draw what
+        // `Sampler::new` draws, past the first window too; the independent kind is untouched.
+        let draws = BOUNCE_DRAWS;
+        for kind in [SAMPLER_SOBOL, SAMPLER_INDEPENDENT] {
+            let pixels = [17, 18].map(|pixel| PixelSamplers::new(kind, pixel, 9));
+            for (index_a, index_b, pixel_b) in [(3, 4, 0), (3, 5, 1), (0, 1 << 20, 1)] {
+                let (pixel_a, pixel_b) = (&pixels[0], &pixels[pixel_b]);
+                let mut a = pixel_a.sampler(index_a);
+                let mut b = pixel_b.sampler(index_b);
+                let mut alone = pixel_a.sampler(index_a);
+                let mut new_a = Sampler::new(kind, 17, index_a, 9);
+                let mut new_b = Sampler::new(kind, pixel_b.pixel, index_b, 9);
+                Sampler::prepare_first_pair(&mut a, pixel_a, &mut b, pixel_b);
+                alone.prepare_first(pixel_a);
+                assert!(!a.window_due() && !b.window_due() && !alone.window_due());
+                for _ in 0..3 {
+                    let expected = new_a.next_batch(draws);
+                    assert_eq!(a.next_batch(draws), expected, "{kind} {index_a}");
+                    assert_eq!(alone.next_batch(draws), expected, "{kind} {index_a}");
+                    assert_eq!(b.next_batch(draws), new_b.next_batch(draws), "{index_b}");
+                }
             }
         }
     }
