@@ -606,12 +606,40 @@ pub fn accumulated_value(radiance: Vec3A) -> Vec3A {
 /// Twin of WGSL `add_sample`.
 #[inline(always)]
 pub fn add_sample(acc: &mut GpuAccumPixel, value: Vec3A) {
-    // v * 2^32 is exact (a float below 2^24 scaled by a power of two), and its integer part is
-    // WGSL's floor(v) * 2^32 + trunc(fract(v) * 2^32): the same fixed-point number, converted
-    // once instead of in two halves.
-    let scaled = value.clamp(Vec3A::ZERO, Vec3A::splat(SAMPLE_MAX)) * 4_294_967_296.0;
-    for (c, x) in scaled.to_array().into_iter().enumerate() {
-        acc.add_to_channel(c, x as u64);
+    let mut sum = FixedSum::default();
+    sum.add(value);
+    sum.add_to(acc);
+}
+
+/// A colour sum in the accumulation's 64-bit fixed point, a `u64` a channel, saturating: the
+/// CPU backend adds a row's samples here, then the row's sums to the accumulation
+/// ([`FixedSum::add_to`]). The same bits as adding each sample there ([`add_sample`]):
+/// saturating sums of numbers that are not negative come out the same in any grouping.
+/// (The accumulation keeps each channel's two halves apart, as WGSL has no 64-bit integers;
+/// adding to them sample after sample made each add wait on the last one's narrowing
+/// stores.)
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FixedSum(pub [u64; 3]);
+
+impl FixedSum {
+    /// `self += value`, `value` clamped to [0, SAMPLE_MAX] as [`add_sample`] does.
+    #[inline(always)]
+    pub fn add(&mut self, value: Vec3A) {
+        // v * 2^32 is exact (a float below 2^24 scaled by a power of two), and its integer
+        // part is WGSL's floor(v) * 2^32 + trunc(fract(v) * 2^32): the same fixed-point
+        // number, converted once instead of in two halves.
+        let scaled = value.clamp(Vec3A::ZERO, Vec3A::splat(SAMPLE_MAX)) * 4_294_967_296.0;
+        for (sum, x) in self.0.iter_mut().zip(scaled.to_array()) {
+            *sum = sum.saturating_add(x as u64);
+        }
+    }
+
+    /// `acc += self`, saturating as the accumulation does.
+    #[inline(always)]
+    pub fn add_to(&self, acc: &mut GpuAccumPixel) {
+        for (c, x) in self.0.into_iter().enumerate() {
+            acc.add_to_channel(c, x);
+        }
     }
 }
 
@@ -683,5 +711,34 @@ mod tests {
         }
         assert_eq!(ours.hi[0], u32::MAX);
         assert_eq!(ours, theirs);
+    }
+
+    /// Samples summed in a [`FixedSum`] first, then added to the accumulation, give the
+    /// bits of adding each to it: onto an empty accumulation and onto one near saturation,
+    /// with sums that saturate in the `FixedSum` itself, and non-finite values.
+    #[test]
+    fn fixed_sums_add_up_as_samples_one_by_one() {
+        let values = [0.3, 1e-30, 7.25, SAMPLE_MAX, f32::NAN, -2.0, 0.1, f32::INFINITY];
+        let near_full = GpuAccumPixel {
+            hi: [u32::MAX - 20_000_000, 5, u32::MAX, 0],
+            lo: [7, u32::MAX, 0, 0],
+        };
+        for start in [GpuAccumPixel::default(), near_full] {
+            for count in [1, 9, 300, 2000] {
+                let (mut one_by_one, mut at_once) = (start, start);
+                let mut sum = FixedSum::default();
+                for i in 0..count {
+                    let v = Vec3A::new(
+                        values[i % values.len()],
+                        values[(i * 3 + 1) % values.len()],
+                        (i as f32).sqrt(),
+                    );
+                    add_sample(&mut one_by_one, v);
+                    sum.add(v);
+                }
+                sum.add_to(&mut at_once);
+                assert_eq!(at_once, one_by_one, "{count} samples onto {start:?}");
+            }
+        }
     }
 }

@@ -10,7 +10,7 @@ use crate::bsdf_lanes::{LaneBsdf, SampleLanes};
 use crate::camera::{film_point, lens_ray, primary_directions};
 use crate::cpu_scene::CpuScene;
 use crate::integrator::{
-    Path, ShadingLanes, ShadowTest, T_MAX, accumulated_value, add_aov_sample, add_sample,
+    FixedSum, Path, ShadingLanes, ShadowTest, T_MAX, accumulated_value, add_aov_sample,
 };
 use crate::intersect::Ray;
 use crate::packet::{Lanes, PACKET, RayPacket};
@@ -22,6 +22,13 @@ use crate::tracer::Tracer;
 pub(crate) struct RowSums<'a> {
     pub color: &'a mut [GpuAccumPixel],
     pub aovs: &'a mut [GpuAovPixel],
+}
+
+/// What a row renderer adds its samples to: sums of the colours of its own (added to the
+/// row's once it is done), and the row's auxiliary images' sums.
+struct RowTotals<'a> {
+    color: &'a mut [FixedSum],
+    aovs: &'a mut [GpuAovPixel],
 }
 
 /// One row's share of an `advance`.
@@ -67,7 +74,7 @@ impl std::iter::Sum for Tally {
 /// cornell-materials 3-4%) and two paths' sampler windows at once (with AVX2's sixteen
 /// registers they cost the furnace 7%: spilled).
 #[inline(always)]
-fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
+fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut RowTotals) -> Tally {
     let (scene, params) = (job.scene, job.params);
     let mut starter = Starter::new(job, row.color.len(), WIDE);
     // Each lane's path, its sampler and the pixel column it adds to; `occupied` says which
@@ -284,7 +291,7 @@ impl<'a> Starter<'a> {
     /// (max_depth 0) is added to `row` and hands its lane to the next sample. Returns what
     /// those did.
     #[inline(always)]
-    fn fill(&mut self, lanes: &mut RowLanes, packet: &mut RayPacket, row: &mut RowSums) -> Tally {
+    fn fill(&mut self, lanes: &mut RowLanes, packet: &mut RayPacket, row: &mut RowTotals) -> Tally {
         let (job, params) = (self.job, self.job.params);
         let mut tally = Tally::default();
         loop {
@@ -375,8 +382,8 @@ impl<'a> Starter<'a> {
 /// Adds the sample of the ended `path` to the sums of pixel `x` of `row` (a non-finite
 /// radiance as zero); returns its rays and whether it was dropped.
 #[inline(always)]
-fn finish(path: &Path, row: &mut RowSums, x: usize) -> Tally {
-    add_sample(&mut row.color[x], accumulated_value(path.sample.radiance));
+fn finish(path: &Path, row: &mut RowTotals, x: usize) -> Tally {
+    row.color[x].add(accumulated_value(path.sample.radiance));
     if let Some(aov) = row.aovs.get_mut(x) {
         add_aov_sample(aov, &path.sample);
     }
@@ -490,21 +497,30 @@ pub(crate) fn render_row_with(
     job: &RowJob,
     row: &mut RowSums,
 ) -> Tally {
-    match isa {
-        InstructionSet::Baseline => render_row::<false>(tracer, job, row),
+    let mut color = vec![FixedSum::default(); row.color.len()];
+    let totals = &mut RowTotals {
+        color: &mut color,
+        aovs: row.aovs,
+    };
+    let tally = match isa {
+        InstructionSet::Baseline => render_row::<false>(tracer, job, totals),
         // SAFETY: `InstructionSet::supported` found the features on this CPU.
         #[cfg(target_arch = "x86_64")]
-        InstructionSet::X86_64V3 => unsafe { render_row_x86_64_v3(tracer, job, row) },
+        InstructionSet::X86_64V3 => unsafe { render_row_x86_64_v3(tracer, job, totals) },
         // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
-        InstructionSet::X86_64V4Gfni => unsafe { render_row_x86_64_v4_gfni(tracer, job, row) },
+        InstructionSet::X86_64V4Gfni => unsafe { render_row_x86_64_v4_gfni(tracer, job, totals) },
+    };
+    for (acc, sum) in row.color.iter_mut().zip(&color) {
+        sum.add_to(acc);
     }
+    tally
 }
 
 /// [`render_row`] for x86-64-v3.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe")]
-fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
+fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut RowTotals) -> Tally {
     render_row::<false>(tracer, job, row)
 }
 
@@ -513,6 +529,6 @@ fn render_row_x86_64_v3(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) ->
 #[target_feature(
     enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,f16c,movbe,avx512f,avx512vl,avx512bw,avx512dq,avx512cd,gfni"
 )]
-fn render_row_x86_64_v4_gfni(tracer: &mut Tracer, job: &RowJob, row: &mut RowSums) -> Tally {
+fn render_row_x86_64_v4_gfni(tracer: &mut Tracer, job: &RowJob, row: &mut RowTotals) -> Tally {
     render_row::<true>(tracer, job, row)
 }
