@@ -718,7 +718,16 @@ mod tests {
     /// with sums that saturate in the `FixedSum` itself, and non-finite values.
     #[test]
     fn fixed_sums_add_up_as_samples_one_by_one() {
-        let values = [0.3, 1e-30, 7.25, SAMPLE_MAX, f32::NAN, -2.0, 0.1, f32::INFINITY];
+        let values = [
+            0.3,
+            1e-30,
+            7.25,
+            SAMPLE_MAX,
+            f32::NAN,
+            -2.0,
+            0.1,
+            f32::INFINITY,
+        ];
         let near_full = GpuAccumPixel {
             hi: [u32::MAX - 20_000_000, 5, u32::MAX, 0],
             lo: [7, u32::MAX, 0, 0],

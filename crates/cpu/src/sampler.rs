@@ -104,12 +104,12 @@ pub struct Sampler {
     index_reversed: u32,
     dimension: u32,
     rng_state: u32,
-    /// Sobol: the values of the [`LANES`] dimensions from `ahead_from` (both coordinates),
+    /// Sobol: the values of the [`LANES`] dimensions from `ahead_from`, per coordinate,
     /// the window [`Sampler::next_batch`] serves from, computed ahead of their use
     /// ([`Sampler::prepare`], or two samplers' at once, [`Sampler::prepare_pair`]; a new
     /// sampler's first from its pixel's seeds, [`Sampler::prepare_first`]) so that
     /// their hash chains' latency overlaps the shading that comes between.
-    ahead: [Vec2; LANES],
+    ahead: Window<LANES>,
     /// The first dimension in `ahead`.
     ahead_from: u32,
     /// The window from `ahead_from` is due: not computed yet ([`Sampler::prepare`] or the
@@ -216,7 +216,10 @@ impl Sampler {
             } else {
                 rng_init(pixel, index, seed)
             },
-            ahead: [Vec2::ZERO; LANES],
+            ahead: Window {
+                x: [0.0; LANES],
+                y: [0.0; LANES],
+            },
             // The camera's dimensions and the first bounce's come from the window at 0.
             ahead_from: 0,
             due: sobol,
@@ -278,9 +281,11 @@ impl Sampler {
     /// Takes the window of `a` (`self`) from the first half of `values`, `b`'s from the
     /// second.
     #[inline(always)]
-    fn take_pair_half(&mut self, b: &mut Self, values: &[Vec2; 2 * LANES]) {
-        self.ahead.copy_from_slice(&values[..LANES]);
-        b.ahead.copy_from_slice(&values[LANES..]);
+    fn take_pair_half(&mut self, b: &mut Self, values: &Window<{ 2 * LANES }>) {
+        self.ahead.x.copy_from_slice(&values.x[..LANES]);
+        self.ahead.y.copy_from_slice(&values.y[..LANES]);
+        b.ahead.x.copy_from_slice(&values.x[LANES..]);
+        b.ahead.y.copy_from_slice(&values.y[LANES..]);
         self.due = false;
         b.due = false;
     }
@@ -375,9 +380,9 @@ impl Sampler {
             offset = 0;
         }
         for i in 0..N {
-            out[i].x = self.ahead[offset + i].x;
+            out[i].x = self.ahead.x[offset + i];
             if draws[i] == Draw::Two {
-                out[i].y = self.ahead[offset + i].y;
+                out[i].y = self.ahead.y[offset + i];
             }
         }
         self.dimension += N as u32;
@@ -390,7 +395,7 @@ impl Sampler {
 
     /// Both coordinates of the [`LANES`] Sobol dimensions from `first`.
     #[inline(always)]
-    fn sobol_lanes(&self, first: u32) -> [Vec2; LANES] {
+    fn sobol_lanes(&self, first: u32) -> Window<LANES> {
         // Always eight lanes (one AVX2 register; the unused ones are wasted): measured 2%
         // faster on a bounce's six than six lanes.
         let mut hashes = [0u32; LANES];
@@ -420,18 +425,26 @@ fn dimension_hashes(first: u32, hashes: &mut [u32]) {
 fn scrambled_sobol<const N: usize>(
     index_reversed: &[u32; N],
     seeds: &ScrambleSeeds<N>,
-) -> [Vec2; N] {
-    let (mut x, mut y) = ([0u32; N], [0u32; N]);
+) -> Window<N> {
+    let mut values = Window {
+        x: [0.0; N],
+        y: [0.0; N],
+    };
     for i in 0..N {
         let index = owen_scramble_reversed(index_reversed[i], seeds.index[i]);
-        x[i] = owen_scramble_reversed(index, seeds.x[i]);
-        y[i] = owen_scramble_reversed(sobol_1_reversed(index), seeds.y[i]);
-    }
-    let mut values = [Vec2::ZERO; N];
-    for i in 0..N {
-        values[i] = Vec2::new(to_unit_float(x[i]), to_unit_float(y[i]));
+        values.x[i] = to_unit_float(owen_scramble_reversed(index, seeds.x[i]));
+        let y = owen_scramble_reversed(sobol_1_reversed(index), seeds.y[i]);
+        values.y[i] = to_unit_float(y);
     }
     values
+}
+
+/// `N` Sobol dimensions' values of a sample, per coordinate (as they are computed, side by
+/// side).
+#[derive(Debug, Clone)]
+struct Window<const N: usize> {
+    x: [f32; N],
+    y: [f32; N],
 }
 
 #[cfg(test)]
