@@ -430,8 +430,8 @@ fn scrambled_sobol<const N: usize>(
         x: [0.0; N],
         y: [0.0; N],
     };
-    for i in 0..N {
-        let index = owen_scramble_reversed(index_reversed[i], seeds.index[i]);
+    for (i, &reversed) in index_reversed.iter().enumerate() {
+        let index = owen_scramble_reversed(reversed, seeds.index[i]);
         values.x[i] = to_unit_float(owen_scramble_reversed(index, seeds.x[i]));
         let y = owen_scramble_reversed(sobol_1_reversed(index), seeds.y[i]);
         values.y[i] = to_unit_float(y);
