@@ -66,16 +66,19 @@ pub(crate) struct PacketRays {
     origin: [[f32; PACKET]; 3],
     dir: [[f32; PACKET]; 3],
     inv_dir: [[f32; PACKET]; 3],
-    /// The rows of each ray's shear into ray space ([`ShearedRay`]), per row and axis.
+    /// The rows of each ray's shear into ray space ([`ShearedRay`]), per row and axis; for
+    /// the triangle tests alone, so zeros in a scene without triangles.
     shear: [[[f32; PACKET]; 3]; 3],
 }
 
 impl PacketRays {
-    /// The packet's rays, their inverse directions and shears computed lane by lane side by
-    /// side (the values of [`crate::intersect::safe_inverse`] and [`ShearedRay::new`] bit for bit: the same
-    /// operations, the axis choices made with masks instead of indices).
+    /// The packet's rays, their inverse directions and (`with_shears`: for a scene with
+    /// triangles) their shears computed lane by lane side by side (the values of
+    /// [`crate::intersect::safe_inverse`] and [`ShearedRay::new`] bit for bit: the same
+    /// operations, the axis choices made with masks instead of indices). The shears cost three
+    /// divisions a ray; a scene of shapes alone never reads them.
     #[inline(always)]
-    pub(crate) fn new(packet: &RayPacket) -> Self {
+    pub(crate) fn new(packet: &RayPacket, with_shears: bool) -> Self {
         let mut rays = Self {
             origin: [[0.0; PACKET]; 3],
             dir: [[1.0; PACKET]; 3],
@@ -99,6 +102,9 @@ impl PacketRays {
                 };
                 rays.inv_dir[axis][l] = 1.0 / fixed;
             }
+        }
+        if !with_shears {
+            return rays;
         }
         for l in 0..PACKET {
             let [dx, dy, dz] = [rays.dir[0][l], rays.dir[1][l], rays.dir[2][l]];
@@ -616,7 +622,7 @@ mod tests {
                     dir: *dir,
                 };
             }
-            let lanes = super::PacketRays::new(&packet);
+            let lanes = super::PacketRays::new(&packet, true);
             for (l, ray) in packet.rays.iter().enumerate() {
                 let inv = Vec3::new(
                     lanes.inv_dir[0][l],

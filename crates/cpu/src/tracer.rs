@@ -57,7 +57,7 @@ impl<'a> Tracer<'a> {
 
     #[inline(always)]
     fn trace_packet(&mut self, packet: &RayPacket, any_hit: bool) -> PacketHits {
-        let rays = PacketRays::new(packet);
+        let rays = PacketRays::new(packet, !self.scene.triangles.is_empty());
         let active = packet.active & (Lanes::MAX >> (Lanes::BITS as usize - PACKET));
         let mut hits = PacketHits::none(packet, active);
         if !self.scene.primitives.is_empty() && active != 0 {
