@@ -62,6 +62,7 @@ impl Default for RayPacket {
 }
 
 /// A packet's rays in structure-of-arrays form, per axis.
+#[derive(Debug, Clone)]
 pub(crate) struct PacketRays {
     origin: [[f32; PACKET]; 3],
     dir: [[f32; PACKET]; 3],
@@ -71,20 +72,26 @@ pub(crate) struct PacketRays {
     shear: [[[f32; PACKET]; 3]; 3],
 }
 
-impl PacketRays {
-    /// The packet's rays, their inverse directions and (`with_shears`: for a scene with
-    /// triangles) their shears computed lane by lane side by side (the values of
-    /// [`crate::intersect::safe_inverse`] and [`ShearedRay::new`] bit for bit: the same
-    /// operations, the axis choices made with masks instead of indices). The shears cost three
-    /// divisions a ray; a scene of shapes alone never reads them.
-    #[inline(always)]
-    pub(crate) fn new(packet: &RayPacket, with_shears: bool) -> Self {
-        let mut rays = Self {
+impl Default for PacketRays {
+    fn default() -> Self {
+        Self {
             origin: [[0.0; PACKET]; 3],
             dir: [[1.0; PACKET]; 3],
             inv_dir: [[1.0; PACKET]; 3],
             shear: [[[0.0; PACKET]; 3]; 3],
-        };
+        }
+    }
+}
+
+impl PacketRays {
+    /// Sets these to the rays of `packet`, their inverse directions and (`with_shears`: for
+    /// a scene with triangles) their shears computed lane by lane side by side (the values of
+    /// [`crate::intersect::safe_inverse`] and [`ShearedRay::new`] bit for bit: the same
+    /// operations, the axis choices made with masks instead of indices). The shears cost three
+    /// divisions a ray; a scene of shapes alone never reads them.
+    #[inline(always)]
+    pub(crate) fn set(&mut self, packet: &RayPacket, with_shears: bool) {
+        let rays = self;
         for (l, ray) in packet.rays.iter().enumerate() {
             for axis in 0..3 {
                 rays.origin[axis][l] = ray.origin[axis];
@@ -104,7 +111,7 @@ impl PacketRays {
             }
         }
         if !with_shears {
-            return rays;
+            return;
         }
         for l in 0..PACKET {
             let [dx, dy, dz] = [rays.dir[0][l], rays.dir[1][l], rays.dir[2][l]];
@@ -135,7 +142,6 @@ impl PacketRays {
                 rays.shear[2][axis][l] = on_z(scale_z);
             }
         }
-        rays
     }
 
     /// Ray `l` in ray space.
@@ -166,7 +172,7 @@ impl PacketRays {
 }
 
 /// The nearest hits of a packet's rays (found so far, during its walk).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct PacketHits {
     t: [f32; PACKET],
     object: [u32; PACKET],
@@ -181,15 +187,10 @@ pub struct PacketHits {
 impl PacketHits {
     /// No hit yet for the rays of `packet`, the `active` ones searching.
     #[inline(always)]
-    pub(crate) fn none(packet: &RayPacket, active: Lanes) -> Self {
-        Self {
-            t: packet.t_max,
-            object: [u32::MAX; PACKET],
-            primitive: [0; PACKET],
-            b1: [0.0; PACKET],
-            b2: [0.0; PACKET],
-            searching: active,
-        }
+    pub(crate) fn reset(&mut self, packet: &RayPacket, active: Lanes) {
+        self.t = packet.t_max;
+        self.object = [u32::MAX; PACKET];
+        self.searching = active;
     }
 
     /// The hit of ray `lane`, if it hit anything.
@@ -585,7 +586,7 @@ mod tests {
     use rand::SeedableRng;
     use rand::rngs::StdRng;
 
-    use super::{Lanes, PACKET, RayPacket};
+    use super::{Lanes, PACKET, PacketHits, RayPacket};
     use crate::bvh::tests::{
         assert_like_brute_force, instanced_objects, prepare, random_ray, ray_into_scene,
     };
@@ -622,7 +623,8 @@ mod tests {
                     dir: *dir,
                 };
             }
-            let lanes = super::PacketRays::new(&packet, true);
+            let mut lanes = super::PacketRays::default();
+            lanes.set(&packet, true);
             for (l, ray) in packet.rays.iter().enumerate() {
                 let inv = Vec3::new(
                     lanes.inv_dir[0][l],
@@ -685,7 +687,9 @@ mod tests {
             "packet",
             &mut |r, t| {
                 let (packet, lane) = packet_of(r, t);
-                tracer.borrow_mut().intersect_packet(&packet).hit(lane)
+                let mut hits = PacketHits::default();
+                tracer.borrow_mut().intersect_packet(&packet, &mut hits);
+                hits.hit(lane)
             },
             &mut |r, t| {
                 let (packet, lane) = packet_of(r, t);

@@ -13,7 +13,7 @@ use crate::integrator::{
     FixedSum, Path, ShadingLanes, ShadowTest, T_MAX, accumulated_value, add_aov_sample,
 };
 use crate::intersect::Ray;
-use crate::packet::{Lanes, PACKET, RayPacket};
+use crate::packet::{Lanes, PACKET, PacketHits, RayPacket};
 use crate::sampler::{PixelSamplers, Sampler};
 use crate::tracer::Tracer;
 
@@ -92,6 +92,7 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
     };
     let mut shadows = RayPacket::default();
     let mut shading = ShadingLanes::default();
+    let mut hits = PacketHits::default();
     // The lanes holding a path; their next rays are in `packet` (written as each went on).
     let mut occupied: Lanes = 0;
     loop {
@@ -101,7 +102,7 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
             return tally;
         }
         occupied = packet.active;
-        let hits = tracer.intersect_packet(&packet);
+        tracer.intersect_packet(&packet, &mut hits);
         let RowLanes {
             paths,
             samplers,

@@ -17,6 +17,11 @@ pub struct Tracer<'a> {
     stack: Vec<Entry>,
     /// The packet walk's stack: nodes and the rays that entered them.
     packet_stack: Vec<(u32, Lanes)>,
+    /// The rays of the packet being walked, written in place for each query (kilobytes that
+    /// a new value a query would be set up and copied).
+    rays: PacketRays,
+    /// The shadow queries' hits.
+    shadow_hits: PacketHits,
 }
 
 impl<'a> Tracer<'a> {
@@ -26,6 +31,8 @@ impl<'a> Tracer<'a> {
             scene,
             stack: Vec::new(),
             packet_stack: Vec::new(),
+            rays: PacketRays::default(),
+            shadow_hits: PacketHits::default(),
         }
     }
 
@@ -42,38 +49,54 @@ impl<'a> Tracer<'a> {
         trace_scene(self.scene, &mut self.stack, ray, t_max, true).object != u32::MAX
     }
 
-    /// Nearest hit in `(0, t_max)` of each active ray of `packet` (none for the others).
+    /// Nearest hit in `(0, t_max)` of each active ray of `packet` (none for the others),
+    /// into `hits`.
     #[inline(always)]
-    pub fn intersect_packet(&mut self, packet: &RayPacket) -> PacketHits {
-        self.trace_packet(packet, false)
+    pub fn intersect_packet(&mut self, packet: &RayPacket, hits: &mut PacketHits) {
+        self.rays.set(packet, !self.scene.triangles.is_empty());
+        let mut stacks = Stacks {
+            packet: &mut self.packet_stack,
+            single: &mut self.stack,
+        };
+        walk_packet(self.scene, &self.rays, &mut stacks, packet, false, hits);
     }
 
     /// Bit `l` set: something lies on active ray `l` of `packet` in `(0, t_max)`.
     #[inline(always)]
     pub fn occluded_packet(&mut self, packet: &RayPacket) -> Lanes {
+        self.rays.set(packet, !self.scene.triangles.is_empty());
+        let mut stacks = Stacks {
+            packet: &mut self.packet_stack,
+            single: &mut self.stack,
+        };
+        let hits = &mut self.shadow_hits;
+        walk_packet(self.scene, &self.rays, &mut stacks, packet, true, hits);
         // Only traced lanes can have found something.
-        self.trace_packet(packet, true).found()
+        hits.found()
     }
+}
 
-    #[inline(always)]
-    fn trace_packet(&mut self, packet: &RayPacket, any_hit: bool) -> PacketHits {
-        let rays = PacketRays::new(packet, !self.scene.triangles.is_empty());
-        let active = packet.active & (Lanes::MAX >> (Lanes::BITS as usize - PACKET));
-        let mut hits = PacketHits::none(packet, active);
-        if !self.scene.primitives.is_empty() && active != 0 {
-            let walk = PacketWalk {
-                scene: self.scene,
-                rays: &rays,
-                any_hit,
-            };
-            self.packet_stack.clear();
-            self.stack.clear();
-            let mut stacks = Stacks {
-                packet: &mut self.packet_stack,
-                single: &mut self.stack,
-            };
-            walk.tree(&mut stacks, 0, active, &mut hits);
-        }
-        hits
+/// Walks the active rays of `packet` (`rays` in the walk's form) through `scene`'s tree,
+/// nearest hits or (`any_hit`) any, into `hits`.
+#[inline(always)]
+fn walk_packet(
+    scene: &CpuScene,
+    rays: &PacketRays,
+    stacks: &mut Stacks,
+    packet: &RayPacket,
+    any_hit: bool,
+    hits: &mut PacketHits,
+) {
+    let active = packet.active & (Lanes::MAX >> (Lanes::BITS as usize - PACKET));
+    hits.reset(packet, active);
+    if !scene.primitives.is_empty() && active != 0 {
+        let walk = PacketWalk {
+            scene,
+            rays,
+            any_hit,
+        };
+        stacks.packet.clear();
+        stacks.single.clear();
+        walk.tree(stacks, 0, active, hits);
     }
 }
