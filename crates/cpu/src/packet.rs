@@ -185,7 +185,9 @@ pub struct PacketHits {
 }
 
 impl PacketHits {
-    /// No hit yet for the rays of `packet`, the `active` ones searching.
+    /// No hit yet for the rays of `packet`, the `active` ones searching: the distances back
+    /// to the rays' ends and no object (a hit's other fields are read only where it found
+    /// one, which writes them all).
     #[inline(always)]
     pub(crate) fn reset(&mut self, packet: &RayPacket, active: Lanes) {
         self.t = packet.t_max;

@@ -248,7 +248,8 @@ struct Starter<'a> {
     pixel: (usize, PixelSamplers),
     previous_pixel: PixelSamplers,
     pinhole: bool,
-    /// New samplers' first windows computed two at a time ([`Sampler::prepare_pair`]).
+    /// New samplers' first windows computed two at a time
+    /// ([`Sampler::prepare_first_pair`]).
     paired_windows: bool,
     /// Per lane, of the sample starting there: its film point (for a pinhole) or camera ray
     /// (with a lens).

@@ -17,8 +17,8 @@ pub struct Tracer<'a> {
     stack: Vec<Entry>,
     /// The packet walk's stack: nodes and the rays that entered them.
     packet_stack: Vec<(u32, Lanes)>,
-    /// The rays of the packet being walked, written in place for each query (kilobytes that
-    /// a new value a query would be set up and copied).
+    /// The rays of the packet being walked, written in place by each query (a new value
+    /// each time was kilobytes set up and copied).
     rays: PacketRays,
     /// The shadow queries' hits.
     shadow_hits: PacketHits,
@@ -53,50 +53,43 @@ impl<'a> Tracer<'a> {
     /// into `hits`.
     #[inline(always)]
     pub fn intersect_packet(&mut self, packet: &RayPacket, hits: &mut PacketHits) {
-        self.rays.set(packet, !self.scene.triangles.is_empty());
-        let mut stacks = Stacks {
-            packet: &mut self.packet_stack,
-            single: &mut self.stack,
-        };
-        walk_packet(self.scene, &self.rays, &mut stacks, packet, false, hits);
+        self.walk_packet(packet, false, Some(hits));
     }
 
     /// Bit `l` set: something lies on active ray `l` of `packet` in `(0, t_max)`.
     #[inline(always)]
     pub fn occluded_packet(&mut self, packet: &RayPacket) -> Lanes {
-        self.rays.set(packet, !self.scene.triangles.is_empty());
-        let mut stacks = Stacks {
-            packet: &mut self.packet_stack,
-            single: &mut self.stack,
-        };
-        let hits = &mut self.shadow_hits;
-        walk_packet(self.scene, &self.rays, &mut stacks, packet, true, hits);
         // Only traced lanes can have found something.
-        hits.found()
+        self.walk_packet(packet, true, None).found()
     }
-}
 
-/// Walks the active rays of `packet` (`rays` in the walk's form) through `scene`'s tree,
-/// nearest hits or (`any_hit`) any, into `hits`.
-#[inline(always)]
-fn walk_packet(
-    scene: &CpuScene,
-    rays: &PacketRays,
-    stacks: &mut Stacks,
-    packet: &RayPacket,
-    any_hit: bool,
-    hits: &mut PacketHits,
-) {
-    let active = packet.active & (Lanes::MAX >> (Lanes::BITS as usize - PACKET));
-    hits.reset(packet, active);
-    if !scene.primitives.is_empty() && active != 0 {
-        let walk = PacketWalk {
-            scene,
-            rays,
-            any_hit,
-        };
-        stacks.packet.clear();
-        stacks.single.clear();
-        walk.tree(stacks, 0, active, hits);
+    /// Walks the active rays of `packet` through the scene's tree, for their nearest hits
+    /// or (`any_hit`) any, into `hits` or else the shadow queries' own; returns those.
+    #[inline(always)]
+    fn walk_packet<'s>(
+        &'s mut self,
+        packet: &RayPacket,
+        any_hit: bool,
+        hits: Option<&'s mut PacketHits>,
+    ) -> &'s PacketHits {
+        let hits = hits.unwrap_or(&mut self.shadow_hits);
+        let active = packet.active & (Lanes::MAX >> (Lanes::BITS as usize - PACKET));
+        hits.reset(packet, active);
+        if !self.scene.primitives.is_empty() && active != 0 {
+            self.rays.set(packet, !self.scene.triangles.is_empty());
+            let walk = PacketWalk {
+                scene: self.scene,
+                rays: &self.rays,
+                any_hit,
+            };
+            self.packet_stack.clear();
+            self.stack.clear();
+            let mut stacks = Stacks {
+                packet: &mut self.packet_stack,
+                single: &mut self.stack,
+            };
+            walk.tree(&mut stacks, 0, active, hits);
+        }
+        hits
     }
 }
