@@ -176,7 +176,7 @@ impl PixelSamplers {
         }
     }
 
-    /// The sampler of sample `index`. Twin of WGSL `sampler_init`.
+    /// The sampler of sample `index` of this pixel: [`Sampler::new`]'s.
     #[inline(always)]
     pub fn sampler(&self, index: u32) -> Sampler {
         Sampler::with_pixel_seed(self.kind, self.pixel_seed, self.pixel, index, self.seed)
