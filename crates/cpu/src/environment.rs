@@ -29,11 +29,12 @@ fn to_map(params: &GpuRenderParams, d: Vec3A) -> Vec3A {
     Vec3A::new(c * d.x - s * d.z, d.y, s * d.x + c * d.z)
 }
 
-/// Map-frame direction to the world. Twin of WGSL `from_map`.
+/// Map-frame direction `[x, y, z]` to the world (on plain numbers: [`map_sample`] is
+/// computed for many lanes side by side). Twin of WGSL `from_map`.
 #[inline(always)]
-fn from_map(params: &GpuRenderParams, d: Vec3A) -> Vec3A {
+fn from_map(params: &GpuRenderParams, [x, y, z]: [f32; 3]) -> [f32; 3] {
     let [c, s] = params.env_rotation;
-    Vec3A::new(c * d.x + s * d.z, d.y, -s * d.x + c * d.z)
+    [c * x + s * z, y, -s * x + c * z]
 }
 
 /// Mitsuba's latitude-longitude coordinates of map-frame `d` (through [`atan2`] and
@@ -52,6 +53,19 @@ pub struct MapCell {
     column: u32,
     row: u32,
     f: Vec2,
+}
+
+impl MapCell {
+    /// Position `f` in the cell between columns `column`, `column + 1` and rows `row`,
+    /// `row + 1`.
+    #[inline(always)]
+    pub(crate) fn new(column: u32, row: u32, f: [f32; 2]) -> Self {
+        Self {
+            column,
+            row,
+            f: Vec2::from(f),
+        }
+    }
 }
 
 /// Twin of WGSL `map_cell`.
@@ -199,6 +213,100 @@ fn cell_pdf(scene: &CpuScene, params: &GpuRenderParams, c: &MapCell) -> f32 {
     p / cell_solid_angle(d, params, c.row)
 }
 
+/// The largest `u` a map sample searches its CDFs for (below 1).
+pub(crate) const MAX_U: f32 = 0.999_999_94;
+
+/// A table read without bounds checks, each index clamped to its last entry instead: a load
+/// that cannot fail is one the compiler can gather for many lanes at once (a checked one is
+/// a branch per lane). The clamp changes nothing for the indices the map's searches make,
+/// all within their tables, and keeps any other index within the table.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Table<'a, T> {
+    values: &'a [T],
+    last: u32,
+}
+
+impl<'a, T: Copy> Table<'a, T> {
+    /// `values` as a table; `None` when empty or longer than a `u32` indexes.
+    #[inline(always)]
+    pub(crate) fn new(values: &'a [T]) -> Option<Self> {
+        let last = u32::try_from(values.len().checked_sub(1)?).ok()?;
+        Some(Self { values, last })
+    }
+
+    /// Entry `i`, or the last entry when `i` is past it.
+    #[inline(always)]
+    pub(crate) fn at(&self, i: u32) -> T {
+        // SAFETY: `last` is the index of the last of `values` (`new`).
+        unsafe { *self.values.get_unchecked(i.min(self.last) as usize) }
+    }
+}
+
+/// What a map sample in cell (`column`, `row`) gives, in plain numbers so that
+/// [`crate::map_lanes`] computes it for many lanes side by side: the world direction, its
+/// solid-angle density and the position in the cell.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct MapSample {
+    pub(crate) wi: [f32; 3],
+    pub(crate) pdf: f32,
+    pub(crate) f: [f32; 2],
+}
+
+/// Probability of entry `k` of the CDF at `start` of `d`, as [`cdf_pmf`] gives it.
+#[inline(always)]
+fn table_pmf(d: Table<'_, f32>, start: u32, k: u32) -> f32 {
+    let before = if k == 0 { 0.0 } else { d.at(start + k - 1) };
+    d.at(start + k) - before
+}
+
+/// The direction, density and cell position of the map sample at `u0`, `u1` (below 1) that
+/// the CDFs' searches put in cell (`column`, `row`): the rest of WGSL `sample_env_map`.
+#[inline(always)]
+pub(crate) fn map_sample(
+    d: Table<'_, f32>,
+    params: &GpuRenderParams,
+    [u0, u1]: [f32; 2],
+    row: u32,
+    column: u32,
+) -> MapSample {
+    let w = params.env_width;
+    let rows = params.env_height - 1;
+    let start = rows + params.env_height + row * w;
+    let p_row = table_pmf(d, 0, row);
+    let p_column = table_pmf(d, start, column);
+    let r0 = ((u0 - (d.at(row) - p_row)) / p_row).clamp(0.0, 1.0);
+    let r1 = ((u1 - (d.at(start + column) - p_column)) / p_column).clamp(0.0, 1.0);
+    let cos0 = d.at(rows + row);
+    let cos1 = d.at(rows + row + 1);
+    let cos_theta = cos0 + (cos1 - cos0) * r0;
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let mut turns = (column as f32 + 0.5 + r1) / w as f32;
+    if turns >= 1.0 {
+        turns -= 1.0;
+    }
+    let (sin_phi, cos_phi) = sin_cos_turns(turns);
+    let dir = [sin_theta * sin_phi, cos_theta, -sin_theta * cos_phi];
+    // The texel position map_cell gives the direction: r1 of the way from column to column
+    // + 1; between the rows by the polar angle (map_uv's v times h - 1).
+    let y = acos(cos_theta.clamp(-1.0, 1.0)) * FRAC_1_PI * rows as f32;
+    // `cell_solid_angle`, from the cosines at hand.
+    let solid_angle = TAU / w as f32 * (cos0 - cos1);
+    MapSample {
+        wi: from_map(params, dir),
+        pdf: p_row * p_column / solid_angle,
+        f: [r1, (y - row as f32).clamp(0.0, 1.0)],
+    }
+}
+
+/// Asks for the cache lines of the texels of cell (`column`, `row`), read once the BSDF is
+/// found to pass the sample on (`light_radiance`).
+#[inline(always)]
+pub(crate) fn prefetch_cell(scene: &CpuScene, params: &GpuRenderParams, row: u32, column: u32) {
+    let top = (row * params.env_width + column) as usize;
+    prefetch(scene.env_texels, top);
+    prefetch(scene.env_texels, top + params.env_width as usize);
+}
+
 /// A direction sampled from the map, its solid-angle density, and the cell and position
 /// there that the direction points to (where [`cell_radiance`] gives the radiance seen along
 /// it: [`env_escape`]'s up to rounding, without turning the direction back into map
@@ -209,45 +317,39 @@ pub fn sample_env_map(
     params: &GpuRenderParams,
     u: Vec2,
 ) -> (Vec3A, f32, MapCell) {
-    let d = scene.env_distribution;
     let w = params.env_width;
     let rows = params.env_height - 1;
-    let u0 = u.x.min(0.999_999_94);
-    let u1 = u.y.min(0.999_999_94);
+    let (u0, u1) = (u.x.min(MAX_U), u.y.min(MAX_U));
     let row = cdf_search(scene, 0, rows, 0, u0);
-    let p_row = cdf_pmf(d, 0, row);
     let start = rows + params.env_height + row * w;
     let column = cdf_search(scene, start, w, rows + 1 + row * (w + 1), u1);
-    let p_column = cdf_pmf(d, start, column);
-    // The texels of the cell, loaded while the BSDF is evaluated (`light_radiance` reads them).
-    let top = (row * w + column) as usize;
-    prefetch(scene.env_texels, top);
-    prefetch(scene.env_texels, top + w as usize);
-    let r0 = ((u0 - (d[row as usize] - p_row)) / p_row).clamp(0.0, 1.0);
-    let r1 = ((u1 - (d[(start + column) as usize] - p_column)) / p_column).clamp(0.0, 1.0);
-    let cos0 = d[(rows + row) as usize];
-    let cos1 = d[(rows + row + 1) as usize];
-    let cos_theta = cos0 + (cos1 - cos0) * r0;
-    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-    let mut turns = (column as f32 + 0.5 + r1) / w as f32;
-    if turns >= 1.0 {
-        turns -= 1.0;
-    }
-    let (sin_phi, cos_phi) = sin_cos_turns(turns);
-    let dir = Vec3A::new(sin_theta * sin_phi, cos_theta, -sin_theta * cos_phi);
-    // The texel position map_cell gives the direction: r1 of the way from column to column
-    // + 1; between the rows by the polar angle (map_uv's v times h - 1).
-    let y = acos(cos_theta.clamp(-1.0, 1.0)) * FRAC_1_PI * rows as f32;
-    let cell = MapCell {
-        column,
-        row,
-        f: Vec2::new(r1, (y - row as f32).clamp(0.0, 1.0)),
+    prefetch_cell(scene, params, row, column);
+    let Some(d) = Table::new(scene.env_distribution) else {
+        return (Vec3A::ZERO, 0.0, MapCell::new(0, 0, [0.0; 2]));
     };
-    (
-        from_map(params, dir),
-        p_row * p_column / cell_solid_angle(d, params, row),
-        cell,
-    )
+    let s = map_sample(d, params, [u0, u1], row, column);
+    (Vec3A::from(s.wi), s.pdf, MapCell::new(column, row, s.f))
+}
+
+/// The light sample of direction `wi`, drawn from the map with density `pdf`, at `cell`.
+#[inline(always)]
+pub(crate) fn map_light_sample(
+    params: &GpuRenderParams,
+    wi: Vec3A,
+    pdf: f32,
+    cell: MapCell,
+) -> LightSample {
+    let pdf = params.env_pmf * pdf;
+    LightSample {
+        wi,
+        point: Vec3A::ZERO,
+        finite: false,
+        radiance: Vec3A::ZERO,
+        pdf,
+        valid: pdf > 0.0 && pdf.is_finite(),
+        mis: true,
+        map_cell: Some(cell),
+    }
 }
 
 /// Density of choosing the environment and direction `wi` from a point with normal `n`
@@ -272,17 +374,7 @@ pub fn sample_environment(
 ) -> LightSample {
     if has_env_map(params) {
         let (wi, pdf, cell) = sample_env_map(scene, params, u);
-        let pdf = params.env_pmf * pdf;
-        return LightSample {
-            wi,
-            point: Vec3A::ZERO,
-            finite: false,
-            radiance: Vec3A::ZERO,
-            pdf,
-            valid: pdf > 0.0 && pdf.is_finite(),
-            mis: true,
-            map_cell: Some(cell),
-        };
+        return map_light_sample(params, wi, pdf, cell);
     }
     let wi = Frame::around(n).to_world(sample_cosine_hemisphere(u));
     let radiance = Vec3A::from(params.environment);

@@ -11,13 +11,14 @@ use crate::bvh::Hit;
 use crate::camera::camera_ray;
 use crate::cpu_scene::CpuScene;
 use crate::diffuse::DiffuseLanes;
-use crate::environment::{env_escape, has_env_map, sample_environment};
+use crate::environment::{env_escape, has_env_map};
 use crate::glass::GlassLanes;
 use crate::glossy::GlossyLanes;
 use crate::intersect::Ray;
 use crate::light_lanes::LitVertex;
 use crate::light_sample::LightSample;
 use crate::lights::{choose_light, light_pdf, light_radiance, sample_light, sample_table_light};
+use crate::map_lanes::sample_env_maps;
 use crate::material::{
     eval_material, has_continuous_material_lobe, is_lambert, lobes_params, material_absorption,
     material_albedo, material_at, sample_material,
@@ -171,23 +172,19 @@ impl ShadingLanes {
     /// gives them to their lanes' kinds to evaluate the BSDF towards.
     #[inline(always)]
     fn sample_map_lights(&mut self, scene: &CpuScene, params: &GpuRenderParams) {
-        let mut left = self.map_lights;
-        while left != 0 {
-            let l = left.trailing_zeros() as usize;
-            left &= left - 1;
-            // (A map's sample does not depend on the normal.)
-            let ls = sample_environment(scene, params, Vec3A::ZERO, self.map_u[l]);
+        let (diffuse, glass, glossy) = (&mut self.diffuse, &mut self.glass, &mut self.glossy);
+        sample_env_maps(scene, params, self.map_lights, &self.map_u, |l, ls| {
             if !ls.valid {
-                continue;
+                return;
             }
-            if self.diffuse.mask >> l & 1 != 0 {
-                self.diffuse.push_light(l, &ls);
-            } else if self.glass.mask >> l & 1 != 0 {
-                self.glass.push_light(l, &ls);
+            if diffuse.mask >> l & 1 != 0 {
+                diffuse.push_light(l, &ls);
+            } else if glass.mask >> l & 1 != 0 {
+                glass.push_light(l, &ls);
             } else {
-                self.glossy.push_light(l, &ls);
+                glossy.push_light(l, &ls);
             }
-        }
+        });
     }
 }
 

@@ -21,6 +21,7 @@ pub mod light_lanes;
 pub mod light_sample;
 pub mod lights;
 pub mod lobes;
+pub mod map_lanes;
 pub mod material;
 pub mod metal_rough;
 pub mod microfacet;
