@@ -9,6 +9,8 @@ use pathlight_core::gpu_types::{
     GpuWideNode, KIND_QUAD,
 };
 
+use crate::table::Table;
+
 /// A view of a [`PreparedScene`] with the buffers of bind group 0 (`scene.wgsl`) side by
 /// side, and per object a quad's unit normal and area (the same values, bit for bit, as
 /// computing them where they are used).
@@ -37,11 +39,12 @@ pub struct CpuScene<'a> {
     /// Texels (WGSL `texels`).
     pub texels: &'a [u32],
     /// The environment map's RGB9E5 texels (WGSL `env_texels`).
-    pub env_texels: &'a [u32],
+    pub env_texels: Table<'a, u32>,
     /// The environment map's sampling distribution (WGSL `env_distribution`).
-    pub env_distribution: &'a [f32],
-    /// Its CDFs' guide tables (the CPU's alone: `EnvironmentData::guides`).
-    pub env_guides: &'a [u16],
+    pub env_distribution: Table<'a, f32>,
+    /// Its CDFs' guide tables (the CPU's alone: `EnvironmentData::guides`; one zero without
+    /// a map).
+    pub env_guides: Table<'a, u16>,
     /// Per object: a quad's unit normal and area; zero for other kinds.
     quads: Vec<(Vec3A, f32)>,
 }
@@ -72,9 +75,9 @@ impl<'a> CpuScene<'a> {
             texture_slots: &scene.shading.texture_slots,
             lights: &scene.shading.lights,
             texels: &scene.textures.texels,
-            env_texels: &scene.environment.texels,
-            env_distribution: &scene.environment.distribution,
-            env_guides: &scene.environment.guides,
+            env_texels: Table::new(&scene.environment.texels, &[0]),
+            env_distribution: Table::new(&scene.environment.distribution, &[0.0]),
+            env_guides: Table::new(&scene.environment.guides, &[0]),
             quads,
         }
     }

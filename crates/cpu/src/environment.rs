@@ -15,6 +15,7 @@ use crate::cpu_scene::CpuScene;
 use crate::light_sample::LightSample;
 use crate::sampling::sin_cos_turns;
 use crate::sampling::{Frame, acos, atan2, first_above, sample_cosine_hemisphere};
+use crate::table::Table;
 
 /// Whether the environment is a map. Twin of WGSL `has_env_map`.
 #[inline(always)]
@@ -22,27 +23,27 @@ pub fn has_env_map(params: &GpuRenderParams) -> bool {
     params.env_width != 0
 }
 
-/// World direction to the map's frame. Twin of WGSL `to_map`.
+/// World direction `[x, y, z]` to the map's frame. These helpers work on plain numbers:
+/// [`crate::map_lanes`] computes them for many lanes side by side. Twin of WGSL `to_map`.
 #[inline(always)]
-fn to_map(params: &GpuRenderParams, d: Vec3A) -> Vec3A {
+pub(crate) fn to_map(params: &GpuRenderParams, [x, y, z]: [f32; 3]) -> [f32; 3] {
     let [c, s] = params.env_rotation;
-    Vec3A::new(c * d.x - s * d.z, d.y, s * d.x + c * d.z)
+    [c * x - s * z, y, s * x + c * z]
 }
 
-/// Map-frame direction `[x, y, z]` to the world (on plain numbers: [`map_sample`] is
-/// computed for many lanes side by side). Twin of WGSL `from_map`.
+/// Map-frame direction `[x, y, z]` to the world. Twin of WGSL `from_map`.
 #[inline(always)]
 fn from_map(params: &GpuRenderParams, [x, y, z]: [f32; 3]) -> [f32; 3] {
     let [c, s] = params.env_rotation;
     [c * x + s * z, y, -s * x + c * z]
 }
 
-/// Mitsuba's latitude-longitude coordinates of map-frame `d` (through [`atan2`] and
+/// Mitsuba's latitude-longitude coordinates of map-frame `[x, y, z]` (through [`atan2`] and
 /// [`acos`], polynomials within 5e-7 of libm's, inline). Twin of WGSL `map_uv`.
 #[inline(always)]
-fn map_uv(d: Vec3A) -> Vec2 {
-    let u = atan2(d.x, -d.z) * (1.0 / TAU);
-    Vec2::new(u - u.floor(), acos(d.y.clamp(-1.0, 1.0)) * FRAC_1_PI)
+pub(crate) fn map_uv([x, y, z]: [f32; 3]) -> [f32; 2] {
+    let u = atan2(x, -z) * (1.0 / TAU);
+    [u - u.floor(), acos(y.clamp(-1.0, 1.0)) * FRAC_1_PI]
 }
 
 /// A cell of the map (between texel columns `column` and `column + 1`, wrapping, and rows
@@ -52,7 +53,7 @@ fn map_uv(d: Vec3A) -> Vec2 {
 pub struct MapCell {
     column: u32,
     row: u32,
-    f: Vec2,
+    f: [f32; 2],
 }
 
 impl MapCell {
@@ -60,31 +61,27 @@ impl MapCell {
     /// `row + 1`.
     #[inline(always)]
     pub(crate) fn new(column: u32, row: u32, f: [f32; 2]) -> Self {
-        Self {
-            column,
-            row,
-            f: Vec2::from(f),
-        }
+        Self { column, row, f }
     }
 }
 
 /// Twin of WGSL `map_cell`.
 #[inline(always)]
-fn map_cell(params: &GpuRenderParams, uv: Vec2) -> MapCell {
+pub(crate) fn map_cell(params: &GpuRenderParams, [u, v]: [f32; 2]) -> MapCell {
     let (w, h) = (params.env_width, params.env_height);
-    let mut x = uv.x * w as f32 - 0.5;
+    let mut x = u * w as f32 - 0.5;
     // Wrapped into [0, w): x starts in [-0.5, w - 0.5] (u in [0, 1]), so this is WGSL's
     // `x - floor(x / w) * w` bit for bit, without its division.
     if x < 0.0 {
         x += w as f32;
     }
-    let y = uv.y * (h - 1) as f32;
+    let y = v * (h - 1) as f32;
     let column = (x as u32).min(w - 1);
     let row = (y as u32).min(h - 2);
     MapCell {
         column,
         row,
-        f: Vec2::new(x - column as f32, y - row as f32),
+        f: [x - column as f32, y - row as f32],
     }
 }
 
@@ -108,34 +105,44 @@ pub fn env_escape(
         };
         return (Vec3A::from(params.environment), pdf);
     }
-    let c = map_cell(params, map_uv(to_map(params, dir)));
+    let c = map_cell(params, map_uv(to_map(params, dir.to_array())));
     let pdf = if mis {
-        params.env_pmf * cell_pdf(scene, params, &c)
+        params.env_pmf * cell_pdf(scene.env_distribution, params, &c)
     } else {
         0.0
     };
     (cell_radiance(scene, params, &c), pdf)
 }
 
-/// Texel `i` of the map (row by row), decoded.
+/// The map's bilinear radiance at `c`, from its `texels`: [`cell_radiance`]'s, in plain
+/// numbers.
 #[inline(always)]
-fn texel(scene: &CpuScene, i: u32) -> Vec3A {
-    Vec3A::from(decode_rgb9e5(scene.env_texels[i as usize]))
-}
-
-/// The map's bilinear radiance at `c`. Twin of WGSL `cell_radiance`.
-#[inline(always)]
-pub fn cell_radiance(scene: &CpuScene, params: &GpuRenderParams, c: &MapCell) -> Vec3A {
+pub(crate) fn cell_color(
+    texels: Table<'_, u32>,
+    params: &GpuRenderParams,
+    c: &MapCell,
+) -> [f32; 3] {
     let w = params.env_width;
     let right = if c.column + 1 == w { 0 } else { c.column + 1 };
     let top = c.row * w;
-    let v00 = texel(scene, top + c.column);
-    let v10 = texel(scene, top + right);
-    let v01 = texel(scene, top + w + c.column);
-    let v11 = texel(scene, top + w + right);
-    let v0 = v00 * (1.0 - c.f.x) + v10 * c.f.x;
-    let v1 = v01 * (1.0 - c.f.x) + v11 * c.f.x;
-    (v0 * (1.0 - c.f.y) + v1 * c.f.y) * params.env_scale
+    let v00 = decode_rgb9e5(texels.at(top + c.column));
+    let v10 = decode_rgb9e5(texels.at(top + right));
+    let v01 = decode_rgb9e5(texels.at(top + w + c.column));
+    let v11 = decode_rgb9e5(texels.at(top + w + right));
+    let [fx, fy] = c.f;
+    // Channel by channel (written out: `array::from_fn` is left out of line).
+    let channel = |i: usize| {
+        let v0 = v00[i] * (1.0 - fx) + v10[i] * fx;
+        let v1 = v01[i] * (1.0 - fx) + v11[i] * fx;
+        (v0 * (1.0 - fy) + v1 * fy) * params.env_scale
+    };
+    [channel(0), channel(1), channel(2)]
+}
+
+/// The map's bilinear radiance at `c` ([`cell_color`]). Twin of WGSL `cell_radiance`.
+#[inline(always)]
+pub fn cell_radiance(scene: &CpuScene, params: &GpuRenderParams, c: &MapCell) -> Vec3A {
+    Vec3A::from(cell_color(scene.env_texels, params, c))
 }
 
 /// Asks for the cache line of `values[i]` (if any) to be loaded ahead of its use, so that
@@ -154,15 +161,12 @@ fn prefetch<T>(values: &[T], i: usize) {
     let _ = (values, i);
 }
 
-/// Probability of entry `k` of the CDF at `start`. Twin of WGSL `cdf_pmf`.
+/// Probability of entry `k` of the CDF at `start` of `d`. Twin of WGSL `cdf_pmf`.
 #[inline(always)]
-fn cdf_pmf(d: &[f32], start: u32, k: u32) -> f32 {
-    let (start, k) = (start as usize, k as usize);
-    if k == 0 {
-        d[start]
-    } else {
-        d[start + k] - d[start + k - 1]
-    }
+fn cdf_pmf(d: Table<'_, f32>, start: u32, k: u32) -> f32 {
+    // The entry before read whatever `k` (a select, not a branch, over many lanes).
+    let before = d.at((start + k).saturating_sub(1));
+    d.at(start + k) - if k == 0 { 0.0 } else { before }
 }
 
 /// First entry of the `n`-entry CDF at `start` exceeding `u` (the last when none does),
@@ -171,42 +175,38 @@ fn cdf_pmf(d: &[f32], start: u32, k: u32) -> f32 {
 /// CDF.
 #[inline(always)]
 fn cdf_search(scene: &CpuScene, start: u32, n: u32, guide: u32, u: f32) -> u32 {
-    let cdf = &scene.env_distribution[start as usize..(start + n) as usize];
+    let cdf = &scene.env_distribution.values()[start as usize..(start + n) as usize];
     let bucket = guide_bucket(u, n);
     // The entry sought usually lies near the bucket's position: its line is loaded while
     // the guide's is.
     prefetch(cdf, bucket as usize);
-    let k = (guide + bucket) as usize;
+    let k = guide + bucket;
     let (lo, hi) = (
-        u32::from(scene.env_guides[k]),
-        u32::from(scene.env_guides[k + 1]),
+        u32::from(scene.env_guides.at(k)),
+        u32::from(scene.env_guides.at(k + 1)),
     );
     lo + first_above(hi - lo + 1, u, |i| cdf[(lo + i) as usize])
 }
 
 /// Solid angle of a cell of `row`. Twin of WGSL `cell_solid_angle`.
 #[inline(always)]
-fn cell_solid_angle(d: &[f32], params: &GpuRenderParams, row: u32) -> f32 {
-    let rows = (params.env_height - 1) as usize;
-    let row = row as usize;
-    TAU / params.env_width as f32 * (d[rows + row] - d[rows + row + 1])
+fn cell_solid_angle(d: Table<'_, f32>, params: &GpuRenderParams, row: u32) -> f32 {
+    let rows = params.env_height - 1;
+    TAU / params.env_width as f32 * (d.at(rows + row) - d.at(rows + row + 1))
 }
 
 /// Solid-angle density of sampling world direction `dir` from the map. Twin of WGSL
 /// `env_map_pdf`.
 #[inline(always)]
 pub fn env_map_pdf(scene: &CpuScene, params: &GpuRenderParams, dir: Vec3A) -> f32 {
-    cell_pdf(
-        scene,
-        params,
-        &map_cell(params, map_uv(to_map(params, dir))),
-    )
+    let c = map_cell(params, map_uv(to_map(params, dir.to_array())));
+    cell_pdf(scene.env_distribution, params, &c)
 }
 
-/// The map's sampling density (solid angle) in cell `c`. Twin of WGSL `cell_pdf`.
+/// The map's sampling density (solid angle) in cell `c`, from its distribution `d`. Twin of
+/// WGSL `cell_pdf`.
 #[inline(always)]
-fn cell_pdf(scene: &CpuScene, params: &GpuRenderParams, c: &MapCell) -> f32 {
-    let d = scene.env_distribution;
+pub(crate) fn cell_pdf(d: Table<'_, f32>, params: &GpuRenderParams, c: &MapCell) -> f32 {
     let rows = params.env_height - 1;
     let conditional = rows + params.env_height + c.row * params.env_width;
     let p = cdf_pmf(d, 0, c.row) * cdf_pmf(d, conditional, c.column);
@@ -216,32 +216,6 @@ fn cell_pdf(scene: &CpuScene, params: &GpuRenderParams, c: &MapCell) -> f32 {
 /// The largest `u` a map sample searches its CDFs for (below 1).
 pub(crate) const MAX_U: f32 = 0.999_999_94;
 
-/// A table read without bounds checks, each index clamped to its last entry instead: a load
-/// that cannot fail is one the compiler can gather for many lanes at once (a checked one is
-/// a branch per lane). The clamp changes nothing for the indices the map's searches make,
-/// all within their tables, and keeps any other index within the table.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Table<'a, T> {
-    values: &'a [T],
-    last: u32,
-}
-
-impl<'a, T: Copy> Table<'a, T> {
-    /// `values` as a table; `None` when empty or longer than a `u32` indexes.
-    #[inline(always)]
-    pub(crate) fn new(values: &'a [T]) -> Option<Self> {
-        let last = u32::try_from(values.len().checked_sub(1)?).ok()?;
-        Some(Self { values, last })
-    }
-
-    /// Entry `i`, or the last entry when `i` is past it.
-    #[inline(always)]
-    pub(crate) fn at(&self, i: u32) -> T {
-        // SAFETY: `last` is the index of the last of `values` (`new`).
-        unsafe { *self.values.get_unchecked(i.min(self.last) as usize) }
-    }
-}
-
 /// What a map sample in cell (`column`, `row`) gives, in plain numbers so that
 /// [`crate::map_lanes`] computes it for many lanes side by side: the world direction, its
 /// solid-angle density and the position in the cell.
@@ -250,13 +224,6 @@ pub(crate) struct MapSample {
     pub(crate) wi: [f32; 3],
     pub(crate) pdf: f32,
     pub(crate) f: [f32; 2],
-}
-
-/// Probability of entry `k` of the CDF at `start` of `d`, as [`cdf_pmf`] gives it.
-#[inline(always)]
-fn table_pmf(d: Table<'_, f32>, start: u32, k: u32) -> f32 {
-    let before = if k == 0 { 0.0 } else { d.at(start + k - 1) };
-    d.at(start + k) - before
 }
 
 /// The direction, density and cell position of the map sample at `u0`, `u1` (below 1) that
@@ -272,8 +239,8 @@ pub(crate) fn map_sample(
     let w = params.env_width;
     let rows = params.env_height - 1;
     let start = rows + params.env_height + row * w;
-    let p_row = table_pmf(d, 0, row);
-    let p_column = table_pmf(d, start, column);
+    let p_row = cdf_pmf(d, 0, row);
+    let p_column = cdf_pmf(d, start, column);
     let r0 = ((u0 - (d.at(row) - p_row)) / p_row).clamp(0.0, 1.0);
     let r1 = ((u1 - (d.at(start + column) - p_column)) / p_column).clamp(0.0, 1.0);
     let cos0 = d.at(rows + row);
@@ -303,8 +270,8 @@ pub(crate) fn map_sample(
 #[inline(always)]
 pub(crate) fn prefetch_cell(scene: &CpuScene, params: &GpuRenderParams, row: u32, column: u32) {
     let top = (row * params.env_width + column) as usize;
-    prefetch(scene.env_texels, top);
-    prefetch(scene.env_texels, top + params.env_width as usize);
+    prefetch(scene.env_texels.values(), top);
+    prefetch(scene.env_texels.values(), top + params.env_width as usize);
 }
 
 /// A direction sampled from the map, its solid-angle density, and the cell and position
@@ -324,10 +291,7 @@ pub fn sample_env_map(
     let start = rows + params.env_height + row * w;
     let column = cdf_search(scene, start, w, rows + 1 + row * (w + 1), u1);
     prefetch_cell(scene, params, row, column);
-    let Some(d) = Table::new(scene.env_distribution) else {
-        return (Vec3A::ZERO, 0.0, MapCell::new(0, 0, [0.0; 2]));
-    };
-    let s = map_sample(d, params, [u0, u1], row, column);
+    let s = map_sample(scene.env_distribution, params, [u0, u1], row, column);
     (Vec3A::from(s.wi), s.pdf, MapCell::new(column, row, s.f))
 }
 
@@ -502,7 +466,7 @@ mod tests {
             for j in 0..n {
                 let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
                 let (wi, _, _) = sample_env_map(&scene, &params, u);
-                let c = map_cell(&params, map_uv(to_map(&params, wi)));
+                let c = map_cell(&params, map_uv(to_map(&params, wi.to_array())));
                 counts[(c.row * w + c.column) as usize] += 1;
             }
         }
@@ -541,12 +505,12 @@ mod tests {
         let mut us = vec![0.0, 1.0, 1.0f32.next_down(), 1e-9, 0.5 / w, 0.5 / w - 1e-7];
         us.extend((0..10_000).map(|i| i as f32 / 9_999.0));
         for u in us {
-            let c = map_cell(&params, Vec2::new(u, 0.3));
+            let c = map_cell(&params, [u, 0.3]);
             let mut x = u * w - 0.5;
             x -= (x / w).floor() * w;
             let column = (x as u32).min(params.env_width - 1);
             assert_eq!(
-                (c.column, c.f.x.to_bits()),
+                (c.column, c.f[0].to_bits()),
                 (column, (x - column as f32).to_bits()),
                 "u {u}"
             );

@@ -18,7 +18,7 @@ use crate::intersect::Ray;
 use crate::light_lanes::LitVertex;
 use crate::light_sample::LightSample;
 use crate::lights::{choose_light, light_pdf, light_radiance, sample_light, sample_table_light};
-use crate::map_lanes::sample_env_maps;
+use crate::map_lanes::{MapEscapes, sample_env_maps};
 use crate::material::{
     eval_material, has_continuous_material_lobe, is_lambert, lobes_params, material_absorption,
     material_albedo, material_at, sample_material,
@@ -104,6 +104,9 @@ pub struct ShadingLanes {
     /// map at `map_u[l]`, its light sample still to be taken.
     map_lights: Lanes,
     map_u: [Vec2; PACKET],
+    /// What the environment map shows the lanes whose rays escaped, computed before their
+    /// steps ([`ShadingLanes::escape`]).
+    escapes: MapEscapes,
 }
 
 impl Default for ShadingLanes {
@@ -117,6 +120,7 @@ impl Default for ShadingLanes {
             glossy: GlossyLanes::default(),
             map_lights: 0,
             map_u: [Vec2::ZERO; PACKET],
+            escapes: MapEscapes::default(),
         }
     }
 }
@@ -129,6 +133,21 @@ impl ShadingLanes {
         self.glass.clear();
         self.glossy.clear();
         self.map_lights = 0;
+    }
+
+    /// With an environment map, computes what it shows the lanes in `escaped`, whose rays
+    /// (`dir(l)`) hit nothing, side by side, for their steps ([`Path::step`]) to take.
+    #[inline(always)]
+    pub fn escape(
+        &mut self,
+        scene: &CpuScene,
+        params: &GpuRenderParams,
+        escaped: Lanes,
+        dir: impl Fn(usize) -> [f32; 3],
+    ) {
+        if has_env_map(params) {
+            self.escapes.compute(scene, params, escaped, dir);
+        }
     }
 
     /// Takes the environment map's light samples left waiting
@@ -272,18 +291,23 @@ impl Path {
             glossy,
             map_lights,
             map_u,
+            escapes,
         } = lanes;
         self.depth += 1;
         self.sample.rays += 1;
         let ray = self.ray;
         let Some(hit) = hit else {
-            let (env, pdf) = env_escape(
-                scene,
-                params,
-                self.prev_normal,
-                ray.dir.into(),
-                !self.prev_delta,
-            );
+            let (env, pdf) = if has_env_map(params) {
+                escapes.get(lane)
+            } else {
+                env_escape(
+                    scene,
+                    params,
+                    self.prev_normal,
+                    ray.dir.into(),
+                    !self.prev_delta,
+                )
+            };
             let w = if self.prev_delta {
                 1.0
             } else {
@@ -564,6 +588,8 @@ pub fn trace_path(
     while path.alive {
         let hit = tracer.intersect(&path.ray, T_MAX);
         lanes.clear();
+        let escaped = Lanes::from(hit.is_none());
+        lanes.escape(scene, params, escaped, |_| path.ray.dir.to_array());
         let mut shadow = path.step::<true>(&mut sampler, scene, params, hit, &mut lanes, 0);
         lanes.compute(scene, params);
         if lanes.map_lights() != 0 {

@@ -34,6 +34,7 @@ pub mod sheen;
 mod soa;
 pub mod sun_light;
 pub mod surface;
+pub mod table;
 pub mod textures;
 pub mod tracer;
 

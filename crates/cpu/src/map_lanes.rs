@@ -1,19 +1,24 @@
-//! The environment map's light samples of a packet's lanes, computed side by side: the same
-//! samples as [`crate::environment::sample_environment`], bit for bit, each step of their
-//! searches one vector operation over the lanes. A sample is a chain of dependent loads
-//! (the row's guide entry and CDF entries, then the column's from megabytes of tables) and
-//! polynomials; taken one lane after another, the core waited on each step of each chain in
-//! turn (`perf`: a quarter of env-sun's time), where side by side the lanes' loads are
-//! gathered at once.
+//! The environment map's light samples of a packet's lanes, and what its escaping rays see,
+//! computed side by side: the same values as [`crate::environment::sample_environment`] and
+//! [`crate::environment::env_escape`], bit for bit, each step one vector operation over the
+//! lanes. A sample is a chain of dependent loads (the row's guide entry and CDF entries, then
+//! the column's from megabytes of tables) and polynomials, an escape a chain of polynomials
+//! (`atan2`, `acos`) and loads (the cell's density and texels); taken one lane after another,
+//! the core waited on each step of each chain in turn (`perf`: a quarter and a fifth of
+//! env-sun's time), where side by side the lanes' loads are gathered at once.
 
 use glam::{Vec2, Vec3A};
 use pathlight_core::environment::guide_bucket;
 use pathlight_core::gpu_types::GpuRenderParams;
 
 use crate::cpu_scene::CpuScene;
-use crate::environment::{MAX_U, MapCell, Table, map_light_sample, map_sample, prefetch_cell};
+use crate::environment::{
+    MAX_U, MapCell, cell_color, cell_pdf, map_cell, map_light_sample, map_sample, map_uv,
+    prefetch_cell, to_map,
+};
 use crate::light_sample::LightSample;
 use crate::packet::{Lanes, PACKET};
+use crate::table::Table;
 
 /// The map's light samples of the lanes in `lanes`, at `u[l]` for lane `l`, given to
 /// `take(l, sample)` in lane order. Every lane is computed (a lane outside `lanes` from
@@ -26,12 +31,7 @@ pub fn sample_env_maps(
     u: &[Vec2; PACKET],
     mut take: impl FnMut(usize, LightSample),
 ) {
-    let (Some(d), Some(guides)) = (
-        Table::new(scene.env_distribution),
-        Table::new(scene.env_guides),
-    ) else {
-        return;
-    };
+    let (d, guides) = (scene.env_distribution, scene.env_guides);
     if lanes == 0 {
         return;
     }
@@ -108,6 +108,70 @@ fn cdf_search_lanes(
     }
 }
 
+/// What the map shows the rays of a packet that escape: per lane, the radiance seen and the
+/// density of sampling the direction from the map, the environment's choice included
+/// ([`crate::environment::env_escape`]'s values with `mis`).
+#[derive(Debug, Clone)]
+pub struct MapEscapes {
+    radiance: [[f32; PACKET]; 3],
+    pdf: [f32; PACKET],
+}
+
+impl Default for MapEscapes {
+    fn default() -> Self {
+        Self {
+            radiance: [[0.0; PACKET]; 3],
+            pdf: [0.0; PACKET],
+        }
+    }
+}
+
+impl MapEscapes {
+    /// Computes every lane's escape along `dir(l)` when a lane of `lanes` escapes (the other
+    /// lanes' values are thrown away).
+    #[inline(always)]
+    pub fn compute(
+        &mut self,
+        scene: &CpuScene,
+        params: &GpuRenderParams,
+        lanes: Lanes,
+        dir: impl Fn(usize) -> [f32; 3],
+    ) {
+        if lanes == 0 {
+            return;
+        }
+        // The directions, everything the lanes read and what they write, in locals: the
+        // compiler cannot tell that stores to `self` leave `scene` and `params` be, or that
+        // `dir` reads nothing the lanes write, and computes one lane at a time unless it can.
+        let mut dirs = [[0.0f32; PACKET]; 3];
+        for (l, [x, y, z]) in (0..PACKET).map(dir).enumerate() {
+            (dirs[0][l], dirs[1][l], dirs[2][l]) = (x, y, z);
+        }
+        let params = *params;
+        let (d, texels) = (scene.env_distribution, scene.env_texels);
+        let mut pdf = [0.0f32; PACKET];
+        let mut radiance = [[0.0f32; PACKET]; 3];
+        for l in 0..PACKET {
+            let dir = [dirs[0][l], dirs[1][l], dirs[2][l]];
+            let c = map_cell(&params, map_uv(to_map(&params, dir)));
+            pdf[l] = params.env_pmf * cell_pdf(d, &params, &c);
+            [radiance[0][l], radiance[1][l], radiance[2][l]] = cell_color(texels, &params, &c);
+        }
+        (self.pdf, self.radiance) = (pdf, radiance);
+    }
+
+    /// Lane `l`'s radiance and density, once [`MapEscapes::compute`] ran with it.
+    #[inline(always)]
+    pub fn get(&self, l: usize) -> (Vec3A, f32) {
+        let radiance = Vec3A::new(
+            self.radiance[0][l],
+            self.radiance[1][l],
+            self.radiance[2][l],
+        );
+        (radiance, self.pdf[l])
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use std::sync::Arc;
@@ -117,7 +181,7 @@ mod tests {
     use pathlight_scene::{Environment, EnvironmentMap, HdrImage};
 
     use super::*;
-    use crate::environment::sample_env_map;
+    use crate::environment::{env_escape, sample_env_map};
 
     /// A `w` x `h` map of random radiance with a few bright texels, turned by 30 degrees.
     fn random_map(w: u32, h: u32, seed: u32) -> (PreparedScene, GpuRenderParams) {
@@ -148,6 +212,42 @@ mod tests {
         let prepared = PreparedScene::new(&scene).unwrap();
         let params = GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
         (prepared, params)
+    }
+
+    #[test]
+    fn escapes_see_what_each_lane_sees_alone() {
+        for (w, h, seed) in [(64, 33, 7), (300, 150, 11), (5, 3, 13)] {
+            let (prepared, params) = random_map(w, h, seed);
+            let scene = CpuScene::new(&prepared);
+            let mut rng = 0x85eb_ca6b_u32 ^ seed;
+            let mut next = move || {
+                rng ^= rng << 13;
+                rng ^= rng >> 17;
+                rng ^= rng << 5;
+                (rng >> 8) as f32 / (1u32 << 24) as f32 * 2.0 - 1.0
+            };
+            let mut escapes = MapEscapes::default();
+            for _ in 0..200 {
+                let mut dirs = [Vec3A::ZERO; PACKET];
+                for d in &mut dirs {
+                    *d = Vec3A::new(next(), next(), next()).normalize_or(Vec3A::Y);
+                }
+                // Straight up and down, and along the seam of the map.
+                dirs[0] = Vec3A::Y;
+                dirs[1] = -Vec3A::Y;
+                dirs[2] = Vec3A::new(0.5, 0.0, 0.0).normalize();
+                escapes.compute(&scene, &params, Lanes::MAX, |l| dirs[l].to_array());
+                for (l, dir) in dirs.iter().enumerate() {
+                    let (radiance, pdf) = escapes.get(l);
+                    let (alone, alone_pdf) = env_escape(&scene, &params, Vec3A::Y, *dir, true);
+                    assert_eq!(
+                        (bits(radiance), pdf.to_bits()),
+                        (bits(alone), alone_pdf.to_bits()),
+                        "{w}x{h}, lane {l}, direction {dir}"
+                    );
+                }
+            }
+        }
     }
 
     fn bits(v: Vec3A) -> [u32; 3] {

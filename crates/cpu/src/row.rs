@@ -108,9 +108,13 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
             samplers,
             columns,
         } = &mut lanes;
+        let found = hits.found();
         if WIDE {
-            prepare_windows(samplers, hits.found() & occupied);
+            prepare_windows(samplers, found & occupied);
         }
+        shading.escape(scene, params, occupied & !found, |l| {
+            packet.rays[l].dir.to_array()
+        });
         shadows.active = 0;
         shading.clear();
         let mut shadow_tests = ShadowTests {
