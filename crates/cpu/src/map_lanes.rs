@@ -183,7 +183,8 @@ mod tests {
     use super::*;
     use crate::environment::{env_escape, sample_env_map};
 
-    /// A `w` x `h` map of random radiance with a few bright texels, turned by 30 degrees.
+    /// A `w` x `h` map of random radiance with a few bright texels, turned by 30 degrees,
+    /// chosen for 0.625 of the light samples.
     fn random_map(w: u32, h: u32, seed: u32) -> (PreparedScene, GpuRenderParams) {
         let mut rng = seed | 1;
         let mut next = move || {
@@ -210,7 +211,9 @@ mod tests {
             rotation_deg: 30.0,
         });
         let prepared = PreparedScene::new(&scene).unwrap();
-        let params = GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
+        let mut params = GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
+        // The environment's share of light samples as beside other lights.
+        params.env_pmf = 0.625;
         (prepared, params)
     }
 
