@@ -139,7 +139,7 @@ pub(crate) fn cell_color(
     [channel(0), channel(1), channel(2)]
 }
 
-/// The map's bilinear radiance at `c` ([`cell_color`]). Twin of WGSL `cell_radiance`.
+/// The map's bilinear radiance at `c` (`cell_color`'s values). Twin of WGSL `cell_radiance`.
 #[inline(always)]
 pub fn cell_radiance(scene: &CpuScene, params: &GpuRenderParams, c: &MapCell) -> Vec3A {
     Vec3A::from(cell_color(scene.env_texels, params, c))
