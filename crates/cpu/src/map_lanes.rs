@@ -183,16 +183,21 @@ mod tests {
     use super::*;
     use crate::environment::{env_escape, sample_env_map};
 
-    /// A `w` x `h` map of random radiance with a few bright texels, turned by 30 degrees,
-    /// chosen for 0.625 of the light samples.
-    fn random_map(w: u32, h: u32, seed: u32) -> (PreparedScene, GpuRenderParams) {
+    /// Uniform numbers in [0, 1) from `seed` (xorshift).
+    fn uniform(seed: u32) -> impl FnMut() -> f32 {
         let mut rng = seed | 1;
-        let mut next = move || {
+        move || {
             rng ^= rng << 13;
             rng ^= rng >> 17;
             rng ^= rng << 5;
             (rng >> 8) as f32 / (1u32 << 24) as f32
-        };
+        }
+    }
+
+    /// A `w` x `h` map of random radiance with a few bright texels, turned by 30 degrees,
+    /// chosen for 0.625 of the light samples.
+    fn random_map(w: u32, h: u32, seed: u32) -> (PreparedScene, GpuRenderParams) {
+        let mut next = uniform(seed);
         let texels = (0..w * h)
             .map(|_| {
                 let v = if next() < 0.01 { 1000.0 } else { next() };
@@ -222,23 +227,26 @@ mod tests {
         for (w, h, seed) in [(64, 33, 7), (300, 150, 11), (5, 3, 13)] {
             let (prepared, params) = random_map(w, h, seed);
             let scene = CpuScene::new(&prepared);
-            let mut rng = 0x85eb_ca6b_u32 ^ seed;
-            let mut next = move || {
-                rng ^= rng << 13;
-                rng ^= rng >> 17;
-                rng ^= rng << 5;
-                (rng >> 8) as f32 / (1u32 << 24) as f32 * 2.0 - 1.0
-            };
+            let mut next = uniform(0x85eb_ca6b ^ seed);
             let mut escapes = MapEscapes::default();
             for _ in 0..200 {
                 let mut dirs = [Vec3A::ZERO; PACKET];
                 for d in &mut dirs {
-                    *d = Vec3A::new(next(), next(), next()).normalize_or(Vec3A::Y);
+                    let v = Vec3A::new(next(), next(), next()) * 2.0 - 1.0;
+                    *d = v.normalize_or(Vec3A::Y);
                 }
-                // Straight up and down, and along the seam of the map.
-                dirs[0] = Vec3A::Y;
-                dirs[1] = -Vec3A::Y;
-                dirs[2] = Vec3A::new(0.5, 0.0, 0.0).normalize();
+                // Straight up and down, and on the map's seam (map frame -z, where u wraps
+                // from 1 to 0) and either side of it.
+                let [c, s] = params.env_rotation;
+                let seam = Vec3A::new(-s, 0.0, -c);
+                let across = Vec3A::new(c, 0.0, -s) * 1e-4;
+                dirs[..5].copy_from_slice(&[
+                    Vec3A::Y,
+                    -Vec3A::Y,
+                    seam,
+                    (seam + across).normalize(),
+                    (seam - across).normalize(),
+                ]);
                 escapes.compute(&scene, &params, Lanes::MAX, |l| dirs[l].to_array());
                 for (l, dir) in dirs.iter().enumerate() {
                     let (radiance, pdf) = escapes.get(l);
@@ -262,13 +270,7 @@ mod tests {
         for (w, h, seed) in [(64, 33, 7), (300, 150, 11), (5, 3, 13)] {
             let (prepared, params) = random_map(w, h, seed);
             let scene = CpuScene::new(&prepared);
-            let mut rng = 0x9e37_79b9_u32 ^ seed;
-            let mut next = move || {
-                rng ^= rng << 13;
-                rng ^= rng >> 17;
-                rng ^= rng << 5;
-                (rng >> 8) as f32 / (1u32 << 24) as f32
-            };
+            let mut next = uniform(0x9e37_79b9 ^ seed);
             for round in 0..200 {
                 let mut u = [Vec2::ZERO; PACKET];
                 for v in &mut u {
