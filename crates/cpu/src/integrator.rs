@@ -185,10 +185,10 @@ impl ShadingLanes {
         }
     }
 
-    /// Takes the environment map's light samples left waiting, one lane after another in a
-    /// loop of their own, so that one lane's loads from the map's megabytes of tables overlap
-    /// the next's (taken in each lane's step, they stalled it: env-sun 9-13% slower), and
-    /// gives them to their lanes' kinds to evaluate the BSDF towards.
+    /// Takes the environment map's light samples left waiting, all lanes side by side
+    /// ([`sample_env_maps`]; taken in each lane's step, and then one lane after another,
+    /// their chains of loads from the map's megabytes of tables stalled the core), and gives
+    /// them to their lanes' kinds to evaluate the BSDF towards.
     #[inline(always)]
     fn sample_map_lights(&mut self, scene: &CpuScene, params: &GpuRenderParams) {
         let (diffuse, glass, glossy) = (&mut self.diffuse, &mut self.glass, &mut self.glossy);
