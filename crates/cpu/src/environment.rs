@@ -356,7 +356,7 @@ pub fn sample_environment(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use std::sync::Arc;
 
     use glam::Vec3;
@@ -382,20 +382,44 @@ mod tests {
             }
         }
         texels[(2 * w + 11) as usize] = [500.0, 400.0, 300.0];
+        map_scene(w, h, texels, 2.0, rotation_deg)
+    }
+
+    /// A scene lit by a `w` x `h` map of `texels` (row by row) alone, `strength` times as
+    /// bright, turned by `rotation_deg`.
+    pub(crate) fn map_scene(
+        w: u32,
+        h: u32,
+        texels: Vec<[f32; 3]>,
+        strength: f32,
+        rotation_deg: f32,
+    ) -> (PreparedScene, GpuRenderParams) {
+        let max = texels.iter().flatten().fold(0.0f32, |m, &v| m.max(v));
         let mut scene = scene_of(Vec::new());
         scene.environment = Environment::Map(EnvironmentMap {
             image: Arc::new(HdrImage {
                 width: w,
                 height: h,
                 texels,
-                max: 500.0,
+                max,
             }),
-            strength: 2.0,
+            strength,
             rotation_deg,
         });
         let prepared = PreparedScene::new(&scene).unwrap();
         let params = GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
         (prepared, params)
+    }
+
+    /// Uniform numbers in [0, 1) from `seed` (xorshift).
+    pub(crate) fn uniform(seed: u32) -> impl FnMut() -> f32 {
+        let mut rng = seed | 1;
+        move || {
+            rng ^= rng << 13;
+            rng ^= rng >> 17;
+            rng ^= rng << 5;
+            (rng >> 8) as f32 / (1u32 << 24) as f32
+        }
     }
 
     /// A uniform direction on the sphere from `u`.
@@ -429,13 +453,7 @@ mod tests {
             // Every sample's density is the density of its direction, and the radiance at
             // its cell the radiance seen along it (to rounding: the texels reach 1000 and
             // change by that much across a cell).
-            let mut rng = 0x2545_f491_u32;
-            let mut next = || {
-                rng ^= rng << 13;
-                rng ^= rng >> 17;
-                rng ^= rng << 5;
-                (rng >> 8) as f32 / (1u32 << 24) as f32
-            };
+            let mut next = uniform(0x2545_f491);
             for _ in 0..20_000 {
                 let (wi, pdf, cell) = sample_env_map(&scene, &params, Vec2::new(next(), next()));
                 assert!((wi.length() - 1.0).abs() < 1e-5);

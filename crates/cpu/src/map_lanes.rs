@@ -174,25 +174,11 @@ impl MapEscapes {
 
 #[cfg(test)]
 mod tests {
-    use std::sync::Arc;
-
     use pathlight_core::PreparedScene;
-    use pathlight_scene::testing::scene_of;
-    use pathlight_scene::{Environment, EnvironmentMap, HdrImage};
 
     use super::*;
+    use crate::environment::tests::{map_scene, uniform};
     use crate::environment::{env_escape, sample_env_map};
-
-    /// Uniform numbers in [0, 1) from `seed` (xorshift).
-    fn uniform(seed: u32) -> impl FnMut() -> f32 {
-        let mut rng = seed | 1;
-        move || {
-            rng ^= rng << 13;
-            rng ^= rng >> 17;
-            rng ^= rng << 5;
-            (rng >> 8) as f32 / (1u32 << 24) as f32
-        }
-    }
 
     /// A `w` x `h` map of random radiance with a few bright texels, turned by 30 degrees,
     /// chosen for 0.625 of the light samples.
@@ -204,19 +190,7 @@ mod tests {
                 [v, v * next(), v * 0.5]
             })
             .collect();
-        let mut scene = scene_of(Vec::new());
-        scene.environment = Environment::Map(EnvironmentMap {
-            image: Arc::new(HdrImage {
-                width: w,
-                height: h,
-                texels,
-                max: 1000.0,
-            }),
-            strength: 1.5,
-            rotation_deg: 30.0,
-        });
-        let prepared = PreparedScene::new(&scene).unwrap();
-        let mut params = GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
+        let (prepared, mut params) = map_scene(w, h, texels, 1.5, 30.0);
         // The environment's share of light samples as beside other lights.
         params.env_pmf = 0.625;
         (prepared, params)
