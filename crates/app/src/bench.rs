@@ -172,9 +172,7 @@ fn measure(
     while frames < args.frames.max(1) {
         let chunk_start = Instant::now();
         let n = chunk.min(args.frames.max(1) - frames);
-        for _ in 0..n {
-            renderer.queue_frame()?;
-        }
+        renderer.queue_frames(n)?;
         renderer.finish()?;
         frames += n;
         if timed_start.elapsed() >= time_limit {

@@ -55,6 +55,16 @@ pub trait Renderer {
     /// where the device works asynchronously; [`Self::finish`] waits.
     fn queue_frame(&mut self) -> Result<(), RenderError>;
 
+    /// Queues `frames` frames as [`Self::queue_frame`] does, one after another; a GPU may
+    /// overlap them (a frame's last segments traced beside the next frame's first), which
+    /// leaves the same image.
+    fn queue_frames(&mut self, frames: u32) -> Result<(), RenderError> {
+        for _ in 0..frames {
+            self.queue_frame()?;
+        }
+        Ok(())
+    }
+
     /// Waits until every queued frame has finished.
     fn finish(&self) -> Result<(), RenderError>;
 

@@ -12,6 +12,12 @@
 // extension ray is shaded, so the estimator and the order of every sum are `trace_path`'s and
 // the images are the same bit for bit (`crates/gpu/tests/gpu/wavefront.rs` holds them
 // together).
+//
+// Frames of one sample each can overlap: a frame's `wf_start` puts its paths in another layer
+// of the path state and appends them to the extension queue while the frames before it are in
+// their last segments, so that those segments, with few paths left, are not traced alone
+// (`Wavefront::submit_frames`). A path's segments do not depend on the paths beside it, and
+// the film's sums are exact, so the image is the same.
 // No CPU twin: the same pass as `integrator.wgsl`, cut into kernels; the CPU backend's twin of
 // that pass is `crates/cpu/src/integrator.rs`.
 
@@ -66,6 +72,14 @@ const QUEUE_SHADOW: u32 = 2u;
 // own writes (the previous kernels wrote them), so every lane may load them as constants,
 // without an atomic each or a barrier to share one.
 @group(2) @binding(3) var<storage, read_write> queue_lengths: array<u32, 8>;
+
+// Where a wave's paths lie and which samples they are: `x`, the first layer of the path state
+// its `wf_start` fills and its `wf_finish` reads (layer l: slots l * band .. (l + 1) * band);
+// `y`, the waves started and not yet finished when its `wf_start` runs. A wave with none
+// ahead of it starts the segments afresh; one with waves ahead appends its camera rays to the
+// extension queue they are in, so that frames overlap (`Wavefront::submit_frames`). The host
+// keeps one entry for each pair in a table and binds it with a dynamic offset.
+@group(2) @binding(4) var<uniform> wave_layer: vec2u;
 
 // The next segment's dispatches, as `dispatch_workgroups_indirect` reads them: the trace
 // kernel's workgroups (x, 1, 1), then the shading's. Each counts one workgroup more than its
@@ -132,26 +146,61 @@ fn path_sampler(slot: u32, dimension: u32, rng_state: u32, sample_index: u32) ->
 }
 
 // Every path of the wave (one path per pixel of the band for each of `num_workgroups.z`
-// samples): its camera ray, queued for extension.
+// samples, from layer `wave_layer.x` on): its camera ray, queued for extension.
+var<workgroup> start_count: atomic<u32>;
+var<workgroup> start_base: u32;
+
 @compute @workgroup_size(8, 8)
-fn wf_start(@builtin(global_invocation_id) gid: vec3u, @builtin(num_workgroups) groups: vec3u) {
+fn wf_start(
+    @builtin(global_invocation_id) gid: vec3u,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(num_workgroups) groups: vec3u,
+) {
     let x = gid.x;
     let y = gid.y + params.row_offset;
-    if x >= params.width || y >= params.row_end {
+    let inside = x < params.width && y < params.row_end;
+    let slot = (wave_layer.x + gid.z) * band_pixels() + (y - params.row_offset) * params.width + x;
+    if wave_layer.y == 0u {
+        if all(gid == vec3u(0u)) {
+            let n = band_pixels() * groups.z;
+            atomicStore(&queue_counts[0], n);
+            atomicStore(&queue_counts[1], 0u);
+            atomicStore(&queue_counts[COUNT_SHADOW], 0u);
+            atomicStore(&queue_counts[COUNT_SHADOW + 1u], 0u);
+            atomicStore(&queue_counts[SEGMENT_TRACE], 0u);
+            atomicStore(&queue_counts[COUNT_WAVE_SAMPLES], groups.z);
+            set_next_dispatch(1u + (n + 63u) / 64u, 1u + (n + 63u) / 64u);
+        }
+        if inside {
+            queues[slot] = slot;
+        }
+    } else {
+        // Waves ahead are in flight: the workgroup's paths join the extension queue the next
+        // segment traces, as one run of entries (one atomic a workgroup), counting the
+        // workgroups of 64 entries the run opens as `enqueue` does.
+        let into = queue_lengths[SEGMENT_TRACE] & 1u;
+        var entry = 0u;
+        if inside {
+            entry = atomicAdd(&start_count, 1u);
+        }
+        workgroupBarrier();
+        if lane == 0u {
+            let count = atomicLoad(&start_count);
+            let base = atomicAdd(&queue_counts[into], count);
+            let opened = (base + count + 63u) / 64u - (base + 63u) / 64u;
+            atomicAdd(&next_dispatch[0], opened);
+            atomicAdd(&next_dispatch[3], opened);
+            start_base = base;
+        }
+        let base = workgroupUniformLoad(&start_base);
+        if inside {
+            queues[into * CAPACITY + base + entry] = slot;
+        }
+    }
+    if !inside {
         return;
     }
-    let slot = gid.z * band_pixels() + (y - params.row_offset) * params.width + x;
-    if slot == 0u {
-        let n = band_pixels() * groups.z;
-        atomicStore(&queue_counts[0], n);
-        atomicStore(&queue_counts[1], 0u);
-        atomicStore(&queue_counts[COUNT_SHADOW], 0u);
-        atomicStore(&queue_counts[COUNT_SHADOW + 1u], 0u);
-        atomicStore(&queue_counts[SEGMENT_TRACE], 0u);
-        atomicStore(&queue_counts[COUNT_WAVE_SAMPLES], groups.z);
-        set_next_dispatch(1u + (n + 63u) / 64u, 1u + (n + 63u) / 64u);
-    }
-    let sample_index = params.sample_offset + queue_lengths[COUNT_SAMPLE] + gid.z;
+    let sample_index = params.sample_offset + queue_lengths[COUNT_SAMPLE] + wave_layer.y + gid.z;
     var sampler = sampler_init(params.sampler, y * params.width + x, sample_index, params.seed);
     let ray = camera_ray(x, y, &sampler);
     var flags = 1u | PATH_PREV_DELTA;
@@ -167,7 +216,6 @@ fn wf_start(@builtin(global_invocation_id) gid: vec3u, @builtin(num_workgroups) 
     paths[field(F_RADIANCE, slot)] = vec4f(vec3f(0.0), bitcast<f32>(sampler.dimension));
     paths[field(F_PREV_POSITION, slot)] = vec4f(ray.origin, bitcast<f32>(sampler.rng_state));
     paths[field(F_PREV_NORMAL, slot)] = vec4f(vec3f(0.0), bitcast<f32>(sample_index));
-    queues[slot] = slot;
 }
 
 // The shadow rays the last segment's shading queued (their light samples' radiance where
@@ -385,7 +433,7 @@ fn wf_finish(@builtin(global_invocation_id) gid: vec3u) {
         var zero = AccumPixel(vec4u(0u), vec4u(0u));
         var aovs = AovPixel(zero, zero);
         for (var s = 0u; s < samples; s++) {
-            let slot = s * band_pixels() + first;
+            let slot = (wave_layer.x + s) * band_pixels() + first;
             let radiance = paths[field(F_RADIANCE, slot)].xyz;
             if is_finite3(radiance) {
                 add_sample(&total, radiance);

@@ -388,10 +388,7 @@ impl GpuRenderer {
         self.use_wavefront = kernel == Kernel::Wavefront;
         let started = Instant::now();
         if frames {
-            for _ in 0..passes {
-                self.submit(0, height, 1);
-                self.cursor.add_passes(1);
-            }
+            self.submit_frames(passes);
         } else {
             self.submit(0, height, passes);
             self.cursor.add_passes(passes);
@@ -487,16 +484,7 @@ impl GpuRenderer {
         samples: u32,
         mut times: Option<&mut DispatchTimes>,
     ) {
-        let params = GpuRenderParams {
-            sample_offset: self.cursor.next_sample(),
-            batch_samples: samples,
-            row_offset: row,
-            row_end: row + rows,
-            ..self.params
-        };
-        self.ctx
-            .queue
-            .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
+        self.write_params(row, rows, samples);
         let mut encoder = self.ctx.device.create_command_encoder(&Default::default());
         if let Some(wavefront) = self.active_wavefront() {
             wavefront.record(
@@ -531,6 +519,51 @@ impl GpuRenderer {
             }
         }
         self.ctx.queue.submit([encoder.finish()]);
+    }
+
+    /// Sets the parameters of the next submission: `samples` samples per pixel of rows
+    /// `row .. row + rows`, from the cursor's next sample.
+    fn write_params(&self, row: u32, rows: u32, samples: u32) {
+        let params = GpuRenderParams {
+            sample_offset: self.cursor.next_sample(),
+            batch_samples: samples,
+            row_offset: row,
+            row_end: row + rows,
+            ..self.params
+        };
+        self.ctx
+            .queue
+            .write_buffer(&self.params_buffer, 0, bytemuck::bytes_of(&params));
+    }
+
+    /// Queues `frames` whole passes of one sample each (a pass must not be under way) and
+    /// counts them: with the wavefront, where its path state holds two frames or more, as one
+    /// run of overlapped frames ([`Wavefront::submit_frames`]); else a pass a
+    /// submission.
+    fn submit_frames(&mut self, frames: u32) {
+        let (height, max_depth) = (self.params.height, self.params.max_depth);
+        let overlapped = self
+            .active_wavefront()
+            .filter(|w| frames > 1 && w.frame_layers(height, max_depth, frames).0 > 1);
+        let Some(wavefront) = overlapped else {
+            for _ in 0..frames {
+                self.submit(0, height, 1);
+                self.cursor.add_passes(1);
+            }
+            return;
+        };
+        self.write_params(0, height, 1);
+        wavefront.submit_frames(
+            &self.ctx.device,
+            &self.ctx.queue,
+            &self.scene.bind_group,
+            &self.frame_bind_group,
+            self.params.width,
+            height,
+            frames,
+            max_depth,
+        );
+        self.cursor.add_passes(frames);
     }
 
     /// Sizes the next pieces from the speed of the last `advance`.
@@ -722,6 +755,25 @@ impl Renderer for GpuRenderer {
         let band = self.cursor.next_band(height, height);
         self.submit(band.start, band.len() as u32, 1);
         self.cursor.add_band(band.end, height);
+        Ok(())
+    }
+
+    /// Whole passes, overlapped where the wavefront renders (`submit_frames`), after
+    /// the `auto` kernel's trial steps and the rest of a pass under way.
+    fn queue_frames(&mut self, frames: u32) -> Result<(), RenderError> {
+        let mut left = frames;
+        while left > 0 {
+            let trial = self.trial_step(true, true, left)?;
+            if trial > 0 {
+                left -= trial;
+            } else if self.cursor.in_pass() {
+                self.queue_frame()?;
+                left -= 1;
+            } else {
+                self.submit_frames(left);
+                left = 0;
+            }
+        }
         Ok(())
     }
 

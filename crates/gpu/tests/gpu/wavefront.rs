@@ -1,7 +1,7 @@
 //! The wavefront kernels against the megakernel: the same sums bit for bit (radiance and
 //! auxiliary images), the same ray and dropped-sample counts, whatever the scene's features,
-//! the path length, and however the work is cut into bands of rows and batches of samples;
-//! and the `auto` kernel, which renders its first passes with both.
+//! the path length, and however the work is cut into bands of rows, batches of samples and
+//! overlapped frames; and the `auto` kernel, which renders its first passes with both.
 
 use pathlight_core::{Accumulation, PreparedScene, Renderer};
 use pathlight_gpu::{Accel, GpuRenderer, Kernel};
@@ -34,6 +34,33 @@ fn render(scene: &Scene, kernel: Kernel, spp: u32, rows: u32, samples: u32) -> O
     while renderer.samples_done() < spp {
         renderer.advance(spp - renderer.samples_done()).unwrap();
     }
+    outcome(&renderer)
+}
+
+/// Renders `frames` frames of `scene` with `kernel` as `pathlight bench` does (queued
+/// together, which the wavefront overlaps), after `band` rows of a first pass when not 0.
+fn render_frames(scene: &Scene, kernel: Kernel, frames: u32, band: u32) -> Outcome {
+    let prepared = PreparedScene::new(scene).unwrap();
+    let mut renderer = GpuRenderer::new(
+        context(),
+        &prepared,
+        &scene.camera,
+        &scene.settings,
+        Accel::Bvh,
+    )
+    .unwrap();
+    renderer.set_kernel(kernel).unwrap();
+    if band > 0 {
+        renderer.set_piece(band, 1);
+        assert_eq!(renderer.advance(1).unwrap(), 0, "a band, not a pass");
+    }
+    renderer.queue_frames(frames).unwrap();
+    renderer.finish().unwrap();
+    outcome(&renderer)
+}
+
+/// What `renderer` has rendered.
+fn outcome(renderer: &GpuRenderer) -> Outcome {
     Outcome {
         accumulation: renderer.accumulation().unwrap(),
         rays: renderer.rays_traced().unwrap(),
@@ -114,6 +141,47 @@ fn wavefront_matches_the_megakernel_bit_for_bit() {
 }
 
 #[test]
+fn overlapped_frames_match_the_megakernel_bit_for_bit() {
+    // Frames queued together start every few segments in layers of the path state of their
+    // own (3 layers, a frame every 3 segments at max_depth 8); the default scene with
+    // auxiliary images, from the start and after a band of a first pass.
+    let mut default =
+        pathlight_scene::load_scene_file(&repo().join("scenes/default.toml")).unwrap();
+    default.camera.width = 37;
+    default.camera.height = 23;
+    default.settings.aovs = true;
+    for band in [0, 5] {
+        let frames = render_frames(&default, Kernel::Wavefront, 7, band);
+        let label = format!("default scene, 7 frames after {band} rows");
+        assert_same_as_megakernel(&label, &default, 7, 23, 1, &frames);
+    }
+    // A frame every segment (max_depth 1, 2 layers); 4 layers of 64 segments of glass, a
+    // frame every 17; the environment map and the sun; samples dropped as NaN.
+    let mut direct = scene("refs/cornell-materials.toml", 20, 2, 3);
+    direct.settings.max_depth = 1;
+    let mut nan = scene("refs/cornell-diffuse.toml", 16, 2, 1);
+    for m in &mut nan.materials {
+        if m.emission.max_element() > 0.0 {
+            m.emission.x = f32::NAN;
+        }
+    }
+    for (label, s, n) in [
+        ("max_depth 1", direct, 5),
+        (
+            "glass furnace",
+            scene("refs/furnace-glass.toml", 16, 2, 5),
+            6,
+        ),
+        ("env-sun", scene("refs/env-sun.toml", 24, 2, 7), 5),
+        ("NaN emission", nan, 5),
+    ] {
+        let frames = render_frames(&s, Kernel::Wavefront, n, 0);
+        let height = s.camera.height;
+        assert_same_as_megakernel(label, &s, n, height, 1, &frames);
+    }
+}
+
+#[test]
 fn wavefront_cuts_a_large_image_into_waves() {
     // 1,000,000 paths: more than lavapipe's 128 MiB bindings hold of path state (838,860
     // paths), so the image is rendered in two waves of rows.
@@ -137,12 +205,13 @@ fn wavefront_counts_the_samples_it_drops() {
 
 #[test]
 fn auto_renders_its_first_passes_with_both_kernels_then_keeps_one() {
-    // 32 samples: the trial takes at most 25 passes (a step of one, then three of up to 8).
-    let s = scene("refs/cornell-spheres.toml", 24, 32, 4);
+    // 330 samples: the trial takes at most 321 passes (a step of one, then five of up to 64).
+    let spp = 330;
+    let s = scene("refs/cornell-spheres.toml", 16, spp, 4);
     // Bands of 8 rows (a pass short enough to time whole), then batches of 3 samples.
-    for (rows, samples) in [(8, 1), (24, 3)] {
+    for (rows, samples) in [(8, 1), (16, 3)] {
         let label = format!("auto, {rows} rows, {samples} samples");
-        let auto = render(&s, Kernel::Auto, 32, rows, samples);
+        let auto = render(&s, Kernel::Auto, spp, rows, samples);
         assert!(
             ["megakernel (auto: ", "wavefront (auto: "]
                 .iter()
@@ -150,11 +219,11 @@ fn auto_renders_its_first_passes_with_both_kernels_then_keeps_one() {
             "{label}: {}",
             auto.kernel
         );
-        assert_same_as_megakernel(&label, &s, 32, rows, samples, &auto);
+        assert_same_as_megakernel(&label, &s, spp, rows, samples, &auto);
     }
     // Three samples: the trial's second step, the wavefront's first, is cut to two passes
     // and the trial goes on.
-    let early = render(&s, Kernel::Auto, 3, 24, 1);
+    let early = render(&s, Kernel::Auto, 3, 16, 1);
     assert!(
         early.kernel.starts_with("auto (not chosen yet"),
         "{}",
