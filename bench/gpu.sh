@@ -14,7 +14,8 @@
 #   cornell-512   scenes/refs/cornell-spheres.toml, 512x512, 64 spp, `pathlight render`:
 #                 whole-process seconds, and the render alone as pathlight reports it
 # bench cases print fps (one sample per pixel per frame) and G rays/s; each cell is the
-# median over the rounds with the range beside it. A case a binary cannot run prints "-".
+# median over the rounds with the range beside it, and the kernel each round rendered with
+# (`auto` picks one per run). A case a binary cannot run prints "-".
 #
 #   bash bench/gpu.sh [--rounds N] [--frames N] [--cases LIST] [BIN...]
 #     BIN: pathlight binaries (default: a fresh release build), each optionally with options
@@ -83,7 +84,9 @@ for round in $(seq "$ROUNDS"); do
                 else
                     fps=$(awk '$1 == "fps" { print $2 }' "$log")
                     rays=$(awk '$1 == "rays/s" { print $2 / 1000 }' "$log")
-                    echo "${fps:-nan} ${rays:-nan}" >>"$out/$case.$i"
+                    # The kernel the run rendered with (M megakernel, W wavefront).
+                    kernel=$(sed -n 's/^settings.*, kernel \([mw]\).*/\1/p' "$log" | tr mw MW)
+                    echo "${fps:-nan} ${rays:-nan} ${kernel:--}" >>"$out/$case.$i"
                 fi
                 if [ "$round" = 1 ] && [ "$case" = "${CASE_LIST[0]}" ]; then
                     grep -m1 -E '^device|backend:' "$log" | sed "s/^/binary $i: /"
@@ -111,10 +114,12 @@ for case in "${CASE_LIST[@]}"; do
         if [ "$case" = cornell-512 ]; then
             cell="$(stat_of "$out/$case.$i" 1 '%.2f s (%.2f-%.2f)'), render $(stat_of "$out/$case.$i" 2 '%.3f s')"
         else
-            cell="$(stat_of "$out/$case.$i" 1 '%.0f fps (%.0f-%.0f)'), $(stat_of "$out/$case.$i" 2 '%.2f G rays/s')"
+            kernels=$(cut -d' ' -f3 "$out/$case.$i" 2>/dev/null | tr -d '\n')
+            cell="$(stat_of "$out/$case.$i" 1 '%.0f fps (%.0f-%.0f)'), $(stat_of "$out/$case.$i" 2 '%.2f G rays/s') ${kernels}"
         fi
         printf ' | %-30s' "$cell"
     done
     printf '\n'
 done
-echo "(median over $ROUNDS rounds, range in brackets; cornell-512: whole process, then the render alone)"
+echo "(median over $ROUNDS rounds, range in brackets, then the kernel of each round: M megakernel,"
+echo " W wavefront; cornell-512: whole process, then the render alone)"
