@@ -3,11 +3,11 @@
 //! the path length, and however the work is cut into bands of rows, batches of samples and
 //! overlapped frames; and the `auto` kernel, which renders its first passes with both.
 
-use pathlight_core::{Accumulation, PreparedScene, Renderer};
-use pathlight_gpu::{Accel, GpuRenderer, Kernel};
+use pathlight_core::{Accumulation, Renderer};
+use pathlight_gpu::{GpuRenderer, Kernel};
 use pathlight_scene::Scene;
 
-use crate::common::{context, repo, scene};
+use crate::common::{gpu_renderer, repo, scene};
 
 /// What a render leaves: the exact sums, the rays traced and samples dropped, and the
 /// renderer's report of its kernel.
@@ -20,15 +20,7 @@ struct Outcome {
 
 /// Renders `scene` to `spp` with `kernel`, `rows` rows and `samples` samples per dispatch.
 fn render(scene: &Scene, kernel: Kernel, spp: u32, rows: u32, samples: u32) -> Outcome {
-    let prepared = PreparedScene::new(scene).unwrap();
-    let mut renderer = GpuRenderer::new(
-        context(),
-        &prepared,
-        &scene.camera,
-        &scene.settings,
-        Accel::Bvh,
-    )
-    .unwrap();
+    let mut renderer = gpu_renderer(scene);
     renderer.set_kernel(kernel).unwrap();
     renderer.set_piece(rows, samples);
     while renderer.samples_done() < spp {
@@ -40,15 +32,7 @@ fn render(scene: &Scene, kernel: Kernel, spp: u32, rows: u32, samples: u32) -> O
 /// Renders `frames` frames of `scene` with `kernel` as `pathlight bench` does (queued
 /// together, which the wavefront overlaps), after `band` rows of a first pass when not 0.
 fn render_frames(scene: &Scene, kernel: Kernel, frames: u32, band: u32) -> Outcome {
-    let prepared = PreparedScene::new(scene).unwrap();
-    let mut renderer = GpuRenderer::new(
-        context(),
-        &prepared,
-        &scene.camera,
-        &scene.settings,
-        Accel::Bvh,
-    )
-    .unwrap();
+    let mut renderer = gpu_renderer(scene);
     renderer.set_kernel(kernel).unwrap();
     if band > 0 {
         renderer.set_piece(band, 1);
