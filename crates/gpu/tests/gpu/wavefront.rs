@@ -91,15 +91,39 @@ fn assert_same_as_megakernel(
     );
 }
 
-#[test]
-fn wavefront_matches_the_megakernel_bit_for_bit() {
-    // The default scene (a texture, glass, metal; odd size) with auxiliary images, in bands
-    // of 5 rows, then in batches of 3 samples over the whole image.
+/// The default scene (a texture, glass, metal) at an odd size, with auxiliary images.
+fn default_scene() -> Scene {
     let mut default =
         pathlight_scene::load_scene_file(&repo().join("scenes/default.toml")).unwrap();
     default.camera.width = 37;
     default.camera.height = 23;
     default.settings.aovs = true;
+    default
+}
+
+/// cornell-materials at 20x20 with camera rays only (max_depth 1).
+fn camera_rays_only() -> Scene {
+    let mut direct = scene("refs/cornell-materials.toml", 20, 2, 3);
+    direct.settings.max_depth = 1;
+    direct
+}
+
+/// cornell-diffuse at 16x16 whose emitters' red is NaN: every sample that sees one is dropped.
+fn nan_emission() -> Scene {
+    let mut s = scene("refs/cornell-diffuse.toml", 16, 2, 1);
+    for m in &mut s.materials {
+        if m.emission.max_element() > 0.0 {
+            m.emission.x = f32::NAN;
+        }
+    }
+    s
+}
+
+#[test]
+fn wavefront_matches_the_megakernel_bit_for_bit() {
+    // The default scene with auxiliary images, in bands of 5 rows, then in batches of 3
+    // samples over the whole image.
+    let default = default_scene();
     assert_same("default scene, bands", &default, 2, 5, 1);
     assert_same("default scene, batches", &default, 6, 23, 3);
     // Instances; glTF's metal-rough layers; an environment map and the sun; many lights.
@@ -112,9 +136,7 @@ fn wavefront_matches_the_megakernel_bit_for_bit() {
         assert_same(name, &scene(name, 24, 2, 7), 2, 24, 2);
     }
     // Camera rays only; long paths (64 segments, no roulette) in glass.
-    let mut direct = scene("refs/cornell-materials.toml", 20, 2, 3);
-    direct.settings.max_depth = 1;
-    assert_same("max_depth 1", &direct, 2, 20, 2);
+    assert_same("max_depth 1", &camera_rays_only(), 2, 20, 2);
     assert_same(
         "glass furnace, 64 segments",
         &scene("refs/furnace-glass.toml", 16, 2, 5),
@@ -129,11 +151,7 @@ fn overlapped_frames_match_the_megakernel_bit_for_bit() {
     // Frames queued together start every few segments in layers of the path state of their
     // own (3 layers, a frame every 3 segments at max_depth 8); the default scene with
     // auxiliary images, from the start and after a band of a first pass.
-    let mut default =
-        pathlight_scene::load_scene_file(&repo().join("scenes/default.toml")).unwrap();
-    default.camera.width = 37;
-    default.camera.height = 23;
-    default.settings.aovs = true;
+    let default = default_scene();
     for band in [0, 5] {
         let frames = render_frames(&default, Kernel::Wavefront, 7, band);
         let label = format!("default scene, 7 frames after {band} rows");
@@ -141,23 +159,15 @@ fn overlapped_frames_match_the_megakernel_bit_for_bit() {
     }
     // A frame every segment (max_depth 1, 2 layers); 4 layers of 64 segments of glass, a
     // frame every 17; the environment map and the sun; samples dropped as NaN.
-    let mut direct = scene("refs/cornell-materials.toml", 20, 2, 3);
-    direct.settings.max_depth = 1;
-    let mut nan = scene("refs/cornell-diffuse.toml", 16, 2, 1);
-    for m in &mut nan.materials {
-        if m.emission.max_element() > 0.0 {
-            m.emission.x = f32::NAN;
-        }
-    }
     for (label, s, n) in [
-        ("max_depth 1", direct, 5),
+        ("max_depth 1", camera_rays_only(), 5),
         (
             "glass furnace",
             scene("refs/furnace-glass.toml", 16, 2, 5),
             6,
         ),
         ("env-sun", scene("refs/env-sun.toml", 24, 2, 7), 5),
-        ("NaN emission", nan, 5),
+        ("NaN emission", nan_emission(), 5),
     ] {
         let frames = render_frames(&s, Kernel::Wavefront, n, 0);
         let height = s.camera.height;
@@ -176,12 +186,7 @@ fn wavefront_cuts_a_large_image_into_waves() {
 
 #[test]
 fn wavefront_counts_the_samples_it_drops() {
-    let mut s = scene("refs/cornell-diffuse.toml", 16, 2, 1);
-    for m in &mut s.materials {
-        if m.emission.max_element() > 0.0 {
-            m.emission.x = f32::NAN;
-        }
-    }
+    let s = nan_emission();
     let wave = render(&s, Kernel::Wavefront, 2, 16, 2);
     assert!(wave.dropped > 10, "{} of 512 samples counted", wave.dropped);
     assert_same("NaN emission", &s, 2, 16, 2);
