@@ -6,9 +6,10 @@ merged without --sparse (so it lists every instrumented function, those it never
 counts). Prints, as a text profile, COMMITTED's records of the functions TRAINED has but never
 ran, their control flow unchanged (the same hash), under the names TRAINED gives them (a local
 function's name starts with its codegen unit's, which a change elsewhere can renumber); names
-them on stderr, the row renderers' first. Fails, naming them, when such a function's control
-flow changed, or when a row renderer COMMITTED has counts for is neither run nor kept: its
-counts would be lost unless a CPU that runs it trains it.
+them on stderr, the row renderers' first. Fails, naming them, when a row renderer COMMITTED
+has counts for is neither run nor kept (its control flow changed, or it is gone): its counts
+would be lost unless a CPU that runs it trains it. Other functions not kept (small ones the
+row calls, changed) are compiled without counts.
 
     tools/pgo_keep.py COMMITTED TRAINED
 """
@@ -42,25 +43,36 @@ def symbol(name):
     return name.rpartition(";")[2]
 
 
+def crate(name):
+    """The crate of a local function's record ("crate.hash" of "crate.hash-cgu.N;"), or ""."""
+    return name.partition(";")[0].rpartition("-cgu.")[0] if ";" in name else ""
+
+
 def main():
     committed, trained = sys.argv[1:3]
     head, committed_records = records(committed)
     trained_head, trained_records = records(trained)
     if head != trained_head:
         sys.exit(f"{committed} and {trained} are profiles of different kinds")
-    not_run = {
-        symbol(lines[0]): lines for lines in trained_records if not any(counters(lines))
-    }
-    run = {symbol(lines[0]) for lines in trained_records if any(counters(lines))}
+    by_name = {lines[0]: lines for lines in trained_records}
+    # The functions not run, by crate and symbol: a generic function has a copy in each
+    # codegen unit that uses it, and a change elsewhere can renumber the units.
+    not_run = {}
+    for lines in trained_records:
+        if not any(counters(lines)):
+            not_run.setdefault((crate(lines[0]), symbol(lines[0])), []).append(lines)
     kept, lost = [], []
     for lines in committed_records:
-        name = symbol(lines[0])
-        if name in run or not any(counters(lines)):
+        now = by_name.get(lines[0])
+        if not any(counters(lines)) or (now is not None and any(counters(now))):
             continue
-        now = not_run.get(name)
-        if now is not None and now[2] == lines[2]:
-            kept.append([now[0]] + lines[1:])
-        elif now is not None or "render_row" in name:
+        copies = not_run.get((crate(lines[0]), symbol(lines[0])), [])
+        same = [copy for copy in copies if copy[2] == lines[2]]
+        same.sort(key=lambda copy: copy[0] != lines[0])  # its own name first
+        if same:
+            copies.remove(same[0])
+            kept.append([same[0][0]] + lines[1:])
+        elif "render_row" in lines[0]:
             lost.append(lines[0])
     if lost:
         names = "\n".join(f"  {name}" for name in lost)
