@@ -7,12 +7,13 @@
 # with the change: a function changed since the profile was made is compiled without one.
 # Needs rustup's llvm-tools (`rustup component add llvm-tools`).
 #
-# On a CPU without a level (x86-64-v4+gfni needs AVX-512 and GFNI), the functions the
-# training did not run (that level's row renderer) keep their counts from the committed
-# profile, named as they are kept: rustc uses them only while their control flow is unchanged
-# (tools/check-pgo.sh fails otherwise; run this on a CPU with every level then). A change that
-# keeps a branch but changes how often it is taken leaves those counts stale: train on a CPU
-# with every level then too.
+# On a CPU with x86-64-v3 but without x86-64-v4+gfni (AVX-512 and GFNI), that level's row
+# renderer is trained by a stand-in: the binary built again with it compiled to x86-64-v3 code
+# from the level's own optimised module (tools/pgo-stand-in), whose counts belong to the
+# control flow the release build compiles (tools/check-pgo.sh checks that) and whose images
+# are the level's bit for bit (checked here). On a CPU without x86-64-v3, the functions the
+# training did not run keep their counts from the committed profile: rustc uses them only
+# while their control flow is unchanged (tools/check-pgo.sh fails otherwise).
 #
 #   tools/pgo.sh
 set -euo pipefail
@@ -25,10 +26,12 @@ if [ -z "$profdata" ]; then
 fi
 counts=$PWD/target/pgo-train/counts
 rm -rf "$counts"
-PATHLIGHT_PGO=generate=$counts CARGO_TARGET_DIR=target/pgo-train \
-    cargo build --release --locked -p pathlight
 pathlight=target/pgo-train/release/pathlight
 out=target/pgo-train/image.exr
+# Builds the instrumented binary, PATHLIGHT_PGO=$1 (tools/rustc-pgo).
+build() {
+    PATHLIGHT_PGO=$1 CARGO_TARGET_DIR=target/pgo-train cargo build --release --locked -p pathlight
+}
 render() {
     local log
     if ! log=$("$pathlight" render "$@" --backend cpu --width 96 --height 96 --spp 16 -o "$out" 2>&1); then
@@ -36,6 +39,18 @@ render() {
         exit 1
     fi
 }
+# Renders the training scenes at level $1, the counts into directory $2.
+train() {
+    export PATHLIGHT_CPU_LEVEL=$1 LLVM_PROFILE_FILE=$2/default_%m.profraw
+    render # the default scene
+    for scene in scenes/*.toml scenes/refs/*.toml; do
+        render "$scene"
+    done
+    render --aov albedo,normal
+    render --sampler independent
+    unset PATHLIGHT_CPU_LEVEL LLVM_PROFILE_FILE
+}
+build "generate=$counts/levels"
 # The levels this CPU runs, as pathlight lists them when asked for one it does not know.
 runs=$(PATHLIGHT_CPU_LEVEL=none "$pathlight" render --backend cpu -o "$out" 2>&1 || true)
 runs=$(sed -n 's/.*this CPU runs the levels //p' <<<"$runs")
@@ -47,31 +62,44 @@ missing=()
 for level in baseline x86-64-v3 x86-64-v4+gfni; do
     if [[ ", $runs, " != *", $level, "* ]]; then
         missing+=("$level")
-        continue
+    else
+        train "$level" "$counts/levels"
     fi
-    export PATHLIGHT_CPU_LEVEL=$level
-    render # the default scene
-    for scene in scenes/*.toml scenes/refs/*.toml; do
-        render "$scene"
-    done
-    render --aov albedo,normal
-    render --sampler independent
 done
+# Keeps, beside the training's counts, those of profile $1 for what the training did not run.
+keep_from() {
+    # Not sparse: every instrumented function, those never run with zero counts.
+    "$profdata" merge --text -o target/pgo-train/trained.proftext "$counts/levels"
+    "$profdata" merge --text -o target/pgo-train/kept-from.proftext "$1"
+    python3 tools/pgo_keep.py target/pgo-train/kept-from.proftext \
+        target/pgo-train/trained.proftext >target/pgo-train/kept.proftext
+    "$profdata" merge --sparse -o pgo/pathlight-cpu.profdata \
+        target/pgo-train/trained.proftext target/pgo-train/kept.proftext
+}
 if [ ${#missing[@]} -eq 0 ]; then
-    "$profdata" merge --sparse -o pgo/pathlight-cpu.profdata "$counts"
+    "$profdata" merge --sparse -o pgo/pathlight-cpu.profdata "$counts/levels"
+elif [ "${missing[*]}" = x86-64-v4+gfni ]; then
+    echo "this CPU lacks x86-64-v4+gfni: its row renderer is trained by a stand-in"
+    build "stand-in=$counts/stand-in"
+    # Every level renders the same image bit for bit: the stand-in too, or its code is wrong.
+    for level in x86-64-v3 x86-64-v4+gfni; do
+        out=target/pgo-train/$level.exr PATHLIGHT_CPU_LEVEL=$level \
+            LLVM_PROFILE_FILE=$counts/check/%m.profraw render scenes/refs/cornell-materials.toml
+    done
+    if ! cmp -s target/pgo-train/x86-64-v3.exr target/pgo-train/x86-64-v4+gfni.exr; then
+        echo "the stand-in's x86-64-v4+gfni image differs from x86-64-v3's" >&2
+        exit 1
+    fi
+    train x86-64-v4+gfni "$counts/stand-in"
+    "$profdata" merge -o target/pgo-train/stand-in.profdata "$counts/stand-in"
+    keep_from target/pgo-train/stand-in.profdata
 else
     if [ ! -f pgo/pathlight-cpu.profdata ]; then
         echo "this CPU lacks ${missing[*]} and there is no profile to keep its counts from" >&2
         exit 1
     fi
-    # Not sparse: every instrumented function, those never run with zero counts.
-    "$profdata" merge --text -o target/pgo-train/trained.proftext "$counts"
-    "$profdata" merge --text -o target/pgo-train/committed.proftext pgo/pathlight-cpu.profdata
     echo "this CPU lacks ${missing[*]}: the functions not run keep the committed profile's counts"
-    python3 tools/pgo_keep.py target/pgo-train/committed.proftext \
-        target/pgo-train/trained.proftext >target/pgo-train/kept.proftext
-    "$profdata" merge --sparse -o pgo/pathlight-cpu.profdata \
-        target/pgo-train/trained.proftext target/pgo-train/kept.proftext
+    keep_from pgo/pathlight-cpu.profdata
 fi
 rustc -vV | sed -n 's/^LLVM version: //p' > pgo/llvm-version
 echo "pgo/pathlight-cpu.profdata: $(du -h pgo/pathlight-cpu.profdata | cut -f1)," \

@@ -1,15 +1,17 @@
 #!/usr/bin/env python3
-"""Keeps a committed profile's counts for the functions a training could not run.
+"""Keeps counts from another profile for the functions a training could not run.
 
-Reads two LLVM text profiles: COMMITTED, the profile in use, and TRAINED, a training's counts
-merged without --sparse (so it lists every instrumented function, those it never ran with zero
-counts). Prints, as a text profile, COMMITTED's records of the functions TRAINED has but never
-ran, their control flow unchanged (the same hash), under the names TRAINED gives them (a local
-function's name starts with its codegen unit's, which a change elsewhere can renumber); names
-them on stderr, the row renderers' first. Fails, naming them, when a row renderer COMMITTED
-has counts for is neither run nor kept (its control flow changed, or it is gone): its counts
-would be lost unless a CPU that runs it trains it. Other functions not kept (small ones the
-row calls, changed) are compiled without counts. Tested by tools/test_pgo_keep.py.
+Reads two LLVM text profiles: COMMITTED, a profile with counts for what the training could not
+run (the committed profile, or the training of tools/pgo.sh's stand-in for a level this CPU
+lacks), and TRAINED, a training's counts merged without --sparse (so it lists every
+instrumented function, those it never ran with zero counts). Prints, as a text profile,
+COMMITTED's records of the functions TRAINED has but never ran, their control flow unchanged
+(the same hash), under the names TRAINED gives them (a local function's name starts with its
+codegen unit's, which a change elsewhere can renumber); names them on stderr, the row
+renderers' first. Fails, naming them, when a row renderer COMMITTED has counts for is neither
+run nor kept (its control flow changed, or it is gone): its counts would be lost unless a CPU
+that runs it trains it. Other functions not kept (small ones the row calls, changed) are
+compiled without counts. Tested by tools/test_pgo_keep.py.
 
     tools/pgo_keep.py COMMITTED TRAINED
 """

@@ -5,4 +5,5 @@ fn main() {
     println!("cargo::rerun-if-changed=../../pgo/pathlight-cpu.profdata");
     println!("cargo::rerun-if-changed=../../pgo/llvm-version");
     println!("cargo::rerun-if-env-changed=PATHLIGHT_PGO");
+    println!("cargo::rustc-check-cfg=cfg(pathlight_pgo_stand_in)");
 }

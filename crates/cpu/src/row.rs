@@ -447,6 +447,10 @@ impl InstructionSet {
                 let v4 = has!("avx512f") && has!("avx512vl") && has!("avx512bw");
                 if v4 && has!("avx512dq") && has!("avx512cd") && has!("gfni") {
                     levels.push(Self::X86_64V4Gfni);
+                } else if cfg!(pathlight_pgo_stand_in) {
+                    // tools/pgo.sh's training build: its x86-64-v4+gfni row renderer is
+                    // compiled for x86-64-v3 (tools/rustc-pgo).
+                    levels.push(Self::X86_64V4Gfni);
                 }
             }
         }
