@@ -11,6 +11,15 @@ use pathlight_core::gpu_types::{
 
 use crate::table::Table;
 
+/// The light table's one entry where a scene has none (never chosen: `light_count` is 0).
+const NO_LIGHT: GpuLight = GpuLight {
+    kind: 0,
+    index: 0,
+    primitive: 0,
+    cdf: 0.0,
+    pmf: 0.0,
+};
+
 /// A view of a [`PreparedScene`] with the buffers of bind group 0 (`scene.wgsl`) side by
 /// side, and per object a quad's unit normal and area (the same values, bit for bit, as
 /// computing them where they are used).
@@ -34,8 +43,9 @@ pub struct CpuScene<'a> {
     pub param_blocks: &'a [[f32; 4]],
     /// The materials' texture slots (WGSL `texture_slots`).
     pub texture_slots: &'a [GpuTextureSlot],
-    /// The light table (WGSL `lights`).
-    pub lights: &'a [GpuLight],
+    /// The light table (WGSL `lights`; read without bounds checks, one entry of nothing
+    /// where the scene has no lights).
+    pub lights: Table<'a, GpuLight>,
     /// Texels (WGSL `texels`).
     pub texels: &'a [u32],
     /// The environment map's RGB9E5 texels (WGSL `env_texels`).
@@ -73,7 +83,7 @@ impl<'a> CpuScene<'a> {
             materials: &scene.shading.materials,
             param_blocks: &scene.shading.param_blocks,
             texture_slots: &scene.shading.texture_slots,
-            lights: &scene.shading.lights,
+            lights: Table::new(&scene.shading.lights, &[NO_LIGHT]),
             texels: &scene.textures.texels,
             env_texels: Table::new(&scene.environment.texels, &[0]),
             env_distribution: Table::new(&scene.environment.distribution, &[0.0]),

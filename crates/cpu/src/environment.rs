@@ -175,17 +175,17 @@ fn cdf_pmf(d: Table<'_, f32>, start: u32, k: u32) -> f32 {
 /// CDF.
 #[inline(always)]
 fn cdf_search(scene: &CpuScene, start: u32, n: u32, guide: u32, u: f32) -> u32 {
-    let cdf = &scene.env_distribution.values()[start as usize..(start + n) as usize];
+    let d = scene.env_distribution;
     let bucket = guide_bucket(u, n);
     // The entry sought usually lies near the bucket's position: its line is loaded while
     // the guide's is.
-    prefetch(cdf, bucket as usize);
+    prefetch(d.values(), (start + bucket) as usize);
     let k = guide + bucket;
     let (lo, hi) = (
         u32::from(scene.env_guides.at(k)),
         u32::from(scene.env_guides.at(k + 1)),
     );
-    lo + first_above(hi - lo + 1, u, |i| cdf[(lo + i) as usize])
+    lo + first_above(hi - lo + 1, u, |i| d.at(start + lo + i))
 }
 
 /// Solid angle of a cell of `row`. Twin of WGSL `cell_solid_angle`.

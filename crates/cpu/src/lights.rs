@@ -36,7 +36,7 @@ pub fn light_pdf(
     } else {
         o.light
     };
-    let pmf = scene.lights[entry as usize].pmf * (1.0 - params.env_pmf);
+    let pmf = scene.lights.at(entry).pmf * (1.0 - params.env_pmf);
     area_light_pdf(scene, o, object, primitive, pmf, p, p_light, n_light)
 }
 
@@ -55,10 +55,8 @@ pub fn choose_light(
     }
     let u_light = ((u_select - params.env_pmf) / (1.0 - params.env_pmf)).min(0.999_999_94);
     // First entry whose cumulative probability exceeds u_light.
-    let entry = first_above(params.light_count, u_light, |i| {
-        scene.lights[i as usize].cdf
-    });
-    let light = scene.lights[entry as usize];
+    let entry = first_above(params.light_count, u_light, |i| scene.lights.at(i).cdf);
+    let light = scene.lights.at(entry);
     // The part of u_light inside the chosen entry, for the light's own choices.
     let below = light.cdf - light.pmf;
     let u_part = ((u_light - below) / light.pmf.max(1e-30)).clamp(0.0, 1.0);
