@@ -55,20 +55,20 @@ pub fn primary_directions(
     dir
 }
 
-/// The jittered point of film a sample of pixel (x, y) aims through (the sampler's next
-/// point: a box filter).
+/// The point of film a sample of pixel (x, y) aims through, jittered by `jitter` in [0, 1)^2
+/// (the sampler's first point: a box filter).
 #[inline(always)]
-pub fn film_point(x: u32, y: u32, sampler: &mut Sampler) -> Vec2 {
-    let jitter = sampler.next_2d();
+pub fn film_point(x: u32, y: u32, jitter: Vec2) -> Vec2 {
     Vec2::new(x as f32 + jitter.x, y as f32 + jitter.y)
 }
 
-/// The ray through film point `film` of a camera with a lens: from a uniform point of the
-/// lens (drawn from `sampler`) towards the plane in focus.
+/// The ray through film point `film` of a camera with a lens: from the point of the lens
+/// that `u` in [0, 1)^2 (the sampler's second point) maps to, uniform over the lens, towards
+/// the plane in focus.
 #[inline(always)]
-pub fn lens_ray(params: &GpuRenderParams, film: Vec2, sampler: &mut Sampler) -> Ray {
+pub fn lens_ray(params: &GpuRenderParams, film: Vec2, u: Vec2) -> Ray {
     let c = &params.camera;
-    let lens = sample_disk(sampler.next_2d()) * c.lens_radius;
+    let lens = sample_disk(u) * c.lens_radius;
     let position = Vec3A::from(c.position);
     let origin = position
         + lens.x * Vec3A::from(c.right).normalize()
@@ -82,11 +82,11 @@ pub fn lens_ray(params: &GpuRenderParams, film: Vec2, sampler: &mut Sampler) -> 
 /// draws no lens sample). Twin of WGSL `camera_ray`.
 #[inline(always)]
 pub fn camera_ray(params: &GpuRenderParams, x: u32, y: u32, sampler: &mut Sampler) -> Ray {
-    let film = film_point(x, y, sampler);
+    let film = film_point(x, y, sampler.next_2d());
     if params.camera.lens_radius <= 0.0 {
         return primary_ray(params, film);
     }
-    lens_ray(params, film, sampler)
+    lens_ray(params, film, sampler.next_2d())
 }
 
 #[cfg(test)]

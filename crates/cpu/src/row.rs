@@ -3,7 +3,7 @@
 
 use std::ops::Range;
 
-use glam::{Vec3, Vec3A};
+use glam::{Vec2, Vec3, Vec3A};
 use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams};
 
 use crate::bsdf_lanes::{LaneBsdf, SampleLanes};
@@ -14,7 +14,7 @@ use crate::integrator::{
 };
 use crate::intersect::Ray;
 use crate::packet::{Lanes, PACKET, PacketHits, RayPacket};
-use crate::sampler::{PixelSamplers, Sampler};
+use crate::sampler::{PixelSamplers, Sampler, camera_points};
 use crate::tracer::Tracer;
 
 /// A row's running sums: the colour's, and the auxiliary images' (empty when the render has
@@ -76,7 +76,7 @@ impl std::iter::Sum for Tally {
 #[inline(always)]
 fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut RowTotals) -> Tally {
     let (scene, params) = (job.scene, job.params);
-    let mut starter = Starter::new(job, row.color.len(), WIDE);
+    let mut starter = Starter::new(job, row.color.len());
     // Each lane's path, its sampler and the pixel column it adds to; `occupied` says which
     // hold one.
     let mut lanes = RowLanes {
@@ -101,6 +101,7 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
         if packet.active == 0 {
             return tally;
         }
+        let started = packet.active & !occupied;
         occupied = packet.active;
         tracer.intersect_packet(&packet, &mut hits);
         let RowLanes {
@@ -109,8 +110,24 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
             columns,
         } = &mut lanes;
         let found = hits.found();
+        // The first windows of the new paths that go on, from their pixels' seeds.
         if WIDE {
+            in_pairs_and_one(found & started, |a, b| match b {
+                Some(b) => {
+                    if let Ok([sampler_a, sampler_b]) = samplers.get_disjoint_mut([a, b]) {
+                        Sampler::prepare_first_pair(sampler_a, sampler_b);
+                    }
+                }
+                None => samplers[a].prepare_first(),
+            });
             prepare_windows(samplers, found & occupied);
+        } else {
+            let mut left = found & started;
+            while left != 0 {
+                let l = left.trailing_zeros() as usize;
+                left &= left - 1;
+                samplers[l].prepare_first();
+            }
         }
         shading.escape(scene, params, occupied & !found, |l| {
             packet.rays[l].dir.to_array()
@@ -203,6 +220,19 @@ fn in_pairs(mut lanes: Lanes, mut pair: impl FnMut(usize, usize)) {
     }
 }
 
+/// Calls `pair` with the lanes of `lanes` two by two, lowest first, and an odd one left
+/// alone (`None` beside it).
+#[inline(always)]
+fn in_pairs_and_one(mut lanes: Lanes, mut pair: impl FnMut(usize, Option<usize>)) {
+    while lanes != 0 {
+        let a = lanes.trailing_zeros() as usize;
+        lanes &= lanes - 1;
+        let b = (lanes != 0).then(|| lanes.trailing_zeros() as usize);
+        lanes &= lanes.wrapping_sub(1);
+        pair(a, b);
+    }
+}
+
 /// A round's shadow rays, and the radiance each adds unless something blocks it.
 struct ShadowTests<'a> {
     packet: &'a mut RayPacket,
@@ -238,23 +268,19 @@ fn leave_sampled<M: LaneBsdf>(
 }
 
 /// The samples of a row still to start (pixel by pixel, each pixel's in turn), and what
-/// starting them needs: a new path's sampler (in its lane) and film point are drawn lane by
-/// lane, then (for a pinhole) the camera rays of all the lanes starting at once, side by side,
-/// so that new paths do not each wait on a division and a square root.
+/// starting them needs: a new path's sampler is made lane by lane, then the camera's sample
+/// values ([`camera_points`]) and (for a pinhole) the camera rays of all the lanes starting at
+/// once, side by side, so that new paths do not each wait on hash chains, a division and a
+/// square root.
 struct Starter<'a> {
     job: &'a RowJob<'a>,
-    samples_per_pixel: usize,
-    /// Samples in the row, and the next to start.
-    count: usize,
-    next: usize,
-    /// The pixel column whose samples start now and what its samplers share, and what the
-    /// samplers of the column before share.
-    pixel: (usize, PixelSamplers),
-    previous_pixel: PixelSamplers,
+    width: usize,
+    /// The pixel column whose samples start now (`width` once all have started), what its
+    /// samplers share, and the index of its next sample to start.
+    column: usize,
+    pixel: PixelSamplers,
+    index: u32,
     pinhole: bool,
-    /// New samplers' first windows computed two at a time
-    /// ([`Sampler::prepare_first_pair`]).
-    paired_windows: bool,
     /// Per lane, of the sample starting there: its film point (for a pinhole) or camera ray
     /// (with a lens).
     film_x: [f32; PACKET],
@@ -264,19 +290,15 @@ struct Starter<'a> {
 
 impl<'a> Starter<'a> {
     #[inline(always)]
-    fn new(job: &'a RowJob<'a>, width: usize, paired_windows: bool) -> Self {
+    fn new(job: &'a RowJob<'a>, width: usize) -> Self {
         let params = job.params;
-        let samples_per_pixel = job.samples.len();
-        let first_pixel = PixelSamplers::new(params.sampler, job.y * params.width, params.seed);
         Self {
             job,
-            samples_per_pixel,
-            count: width * samples_per_pixel,
-            next: 0,
-            pixel: (0, first_pixel),
-            previous_pixel: first_pixel,
+            width,
+            column: if job.samples.is_empty() { width } else { 0 },
+            pixel: PixelSamplers::new(params.sampler, job.y * params.width, params.seed),
+            index: job.samples.start,
             pinhole: params.camera.lens_radius <= 0.0,
-            paired_windows,
             film_x: [0.0; PACKET],
             film_y: [0.0; PACKET],
             lens_rays: RayPacket::default().rays,
@@ -295,64 +317,50 @@ impl<'a> Starter<'a> {
     /// Starts the next samples in the `lanes` that `packet.active` leaves empty (it marks
     /// those holding a path), their camera rays into `packet`; a path that ends at once
     /// (max_depth 0) is added to `row` and hands its lane to the next sample. Returns what
-    /// those did.
+    /// those did. A new path's first sampler window is left due: computed once its camera
+    /// ray is known to meet something ([`Sampler::prepare_first`]).
     #[inline(always)]
     fn fill(&mut self, lanes: &mut RowLanes, packet: &mut RayPacket, row: &mut RowTotals) -> Tally {
         let (job, params) = (self.job, self.job.params);
         let mut tally = Tally::default();
         loop {
             let mut starting: Lanes = 0;
-            let mut waiting = None;
             let mut empty = !packet.active & Lanes::MAX >> (Lanes::BITS - PACKET as u32);
-            while empty != 0 && self.next != self.count {
+            while empty != 0 && self.column != self.width {
                 let l = empty.trailing_zeros() as usize;
                 empty &= empty - 1;
-                let x = self.next / self.samples_per_pixel;
-                let i = job.samples.start + (self.next % self.samples_per_pixel) as u32;
-                self.next += 1;
-                if x != self.pixel.0 {
-                    let pixel = job.y * params.width + x as u32;
-                    let samplers = PixelSamplers::new(params.sampler, pixel, params.seed);
-                    self.previous_pixel = std::mem::replace(&mut self.pixel, (x, samplers)).1;
-                }
-                let pixel = &self.pixel.1;
-                lanes.samplers[l] = pixel.sampler(i);
-                lanes.columns[l] = x;
+                lanes.samplers[l] = self.pixel.sampler(self.index);
+                lanes.columns[l] = self.column;
                 starting |= 1 << l;
-                // Its first window: where the registers are wide, with the sampler started
-                // before (of this pixel or the one before), two side by side.
-                if !self.paired_windows {
-                    lanes.samplers[l].prepare_first(pixel);
-                } else if let Some(a) = waiting.take() {
-                    let pixel_a = if lanes.columns[a] == x {
-                        pixel
-                    } else {
-                        &self.previous_pixel
-                    };
-                    if let Ok([sampler_a, sampler]) = lanes.samplers.get_disjoint_mut([a, l]) {
-                        Sampler::prepare_first_pair(sampler_a, pixel_a, sampler, pixel);
+                self.index += 1;
+                if self.index == job.samples.end {
+                    self.column += 1;
+                    self.index = job.samples.start;
+                    if self.column != self.width {
+                        let pixel = job.y * params.width + self.column as u32;
+                        self.pixel = PixelSamplers::new(params.sampler, pixel, params.seed);
                     }
-                } else {
-                    waiting = Some(l);
                 }
-            }
-            if let Some(a) = waiting {
-                // The last started, so of the pixel whose samples start now.
-                lanes.samplers[a].prepare_first(&self.pixel.1);
             }
             if starting == 0 {
                 return tally;
             }
+            let [jitter, lens] = camera_points(
+                &mut lanes.samplers,
+                starting,
+                if self.pinhole { 1 } else { 2 },
+            );
             let mut left = starting;
             while left != 0 {
                 let l = left.trailing_zeros() as usize;
                 left &= left - 1;
-                let (x, sampler) = (lanes.columns[l], &mut lanes.samplers[l]);
-                let film = film_point(x as u32, job.y, sampler);
+                let jitter = Vec2::new(jitter.x[l], jitter.y[l]);
+                let film = film_point(lanes.columns[l] as u32, job.y, jitter);
                 if self.pinhole {
                     (self.film_x[l], self.film_y[l]) = (film.x, film.y);
                 } else {
-                    self.lens_rays[l] = lens_ray(params, film, sampler);
+                    let u = Vec2::new(lens.x[l], lens.y[l]);
+                    self.lens_rays[l] = lens_ray(params, film, u);
                 }
             }
             let dir = self

@@ -10,6 +10,8 @@
 use glam::Vec2;
 use pathlight_core::gpu_types::SAMPLER_SOBOL;
 
+use crate::packet::{Lanes, PACKET};
+
 /// PCG hash (Jarzynski and Olano, JCGT 2020). Twin of WGSL `pcg_hash`.
 pub const fn pcg_hash(v: u32) -> u32 {
     let state = v.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
@@ -110,6 +112,8 @@ pub struct Sampler {
     /// sampler's first from its pixel's seeds, [`Sampler::prepare_first`]) so that
     /// their hash chains' latency overlaps the shading that comes between.
     ahead: Window<LANES>,
+    /// Sobol: the scrambles' seeds of the first window's dimensions (its pixel's).
+    first_seeds: ScrambleSeeds<LANES>,
     /// The first dimension in `ahead`.
     ahead_from: u32,
     /// The window from `ahead_from` is due: not computed yet ([`Sampler::prepare`] or the
@@ -179,7 +183,26 @@ impl PixelSamplers {
     /// The sampler of sample `index` of this pixel: [`Sampler::new`]'s.
     #[inline(always)]
     pub fn sampler(&self, index: u32) -> Sampler {
-        Sampler::with_pixel_seed(self.kind, self.pixel_seed, self.pixel, index, self.seed)
+        let sobol = self.kind == SAMPLER_SOBOL;
+        Sampler {
+            kind: self.kind,
+            pixel_seed: self.pixel_seed,
+            index_reversed: index.reverse_bits(),
+            dimension: 0,
+            rng_state: if sobol {
+                0
+            } else {
+                rng_init(self.pixel, index, self.seed)
+            },
+            ahead: Window {
+                x: [0.0; LANES],
+                y: [0.0; LANES],
+            },
+            first_seeds: self.first_seeds,
+            // The camera's dimensions and the first bounce's come from the window at 0.
+            ahead_from: 0,
+            due: sobol,
+        }
     }
 }
 
@@ -187,8 +210,7 @@ impl Sampler {
     /// Sample `index` of `pixel` under `seed`, of kind `SAMPLER_*`. Twin of WGSL `sampler_init`.
     #[inline(always)]
     pub fn new(kind: u32, pixel: u32, index: u32, seed: u32) -> Self {
-        let pixel_seed = Self::pixel_seed(kind, pixel, seed);
-        Self::with_pixel_seed(kind, pixel_seed, pixel, index, seed)
+        PixelSamplers::new(kind, pixel, seed).sampler(index)
     }
 
     /// Sobol: the seed of `pixel` under `seed` (each kind hashes only the state it reads;
@@ -199,30 +221,6 @@ impl Sampler {
             pcg_hash(pixel ^ pcg_hash(seed))
         } else {
             0
-        }
-    }
-
-    /// [`Sampler::new`], given the pixel's seed.
-    #[inline(always)]
-    fn with_pixel_seed(kind: u32, pixel_seed: u32, pixel: u32, index: u32, seed: u32) -> Self {
-        let sobol = kind == SAMPLER_SOBOL;
-        Self {
-            kind,
-            pixel_seed,
-            index_reversed: index.reverse_bits(),
-            dimension: 0,
-            rng_state: if sobol {
-                0
-            } else {
-                rng_init(pixel, index, seed)
-            },
-            ahead: Window {
-                x: [0.0; LANES],
-                y: [0.0; LANES],
-            },
-            // The camera's dimensions and the first bounce's come from the window at 0.
-            ahead_from: 0,
-            due: sobol,
         }
     }
 
@@ -237,28 +235,24 @@ impl Sampler {
         }
     }
 
-    /// [`Sampler::prepare`] of a new sampler of `pixel`'s, from the scrambles' seeds it keeps.
+    /// [`Sampler::prepare`] of a new sampler (its first window, from dimension 0), from its
+    /// pixel's scrambles' seeds, which it keeps.
     #[inline(always)]
-    pub fn prepare_first(&mut self, pixel: &PixelSamplers) {
+    pub fn prepare_first(&mut self) {
         if self.due {
             debug_assert_eq!(self.ahead_from, 0, "not a new sampler");
-            self.ahead = scrambled_sobol(&[self.index_reversed; LANES], &pixel.first_seeds);
+            self.ahead = scrambled_sobol(&[self.index_reversed; LANES], &self.first_seeds);
             self.due = false;
         }
     }
 
-    /// [`Sampler::prepare_first`] of `a`, a new sampler of `pixel_a`'s, and `b`, of
-    /// `pixel_b`'s, side by side as [`Sampler::prepare_pair`] computes them.
+    /// [`Sampler::prepare_first`] of `a` and `b`, side by side as [`Sampler::prepare_pair`]
+    /// computes them.
     #[inline(always)]
-    pub fn prepare_first_pair(
-        a: &mut Self,
-        pixel_a: &PixelSamplers,
-        b: &mut Self,
-        pixel_b: &PixelSamplers,
-    ) {
+    pub fn prepare_first_pair(a: &mut Self, b: &mut Self) {
         if !(a.due && b.due) {
-            a.prepare_first(pixel_a);
-            b.prepare_first(pixel_b);
+            a.prepare_first();
+            b.prepare_first();
             return;
         }
         debug_assert!(a.ahead_from == 0 && b.ahead_from == 0, "not new samplers");
@@ -268,11 +262,11 @@ impl Sampler {
             x: [0; 2 * LANES],
             y: [0; 2 * LANES],
         };
-        for (half, pixel) in [(0, pixel_a), (LANES, pixel_b)] {
+        for (half, sampler) in [(0, &*a), (LANES, &*b)] {
             let lanes = half..half + LANES;
-            seeds.index[lanes.clone()].copy_from_slice(&pixel.first_seeds.index);
-            seeds.x[lanes.clone()].copy_from_slice(&pixel.first_seeds.x);
-            seeds.y[lanes].copy_from_slice(&pixel.first_seeds.y);
+            seeds.index[lanes.clone()].copy_from_slice(&sampler.first_seeds.index);
+            seeds.x[lanes.clone()].copy_from_slice(&sampler.first_seeds.x);
+            seeds.y[lanes].copy_from_slice(&sampler.first_seeds.y);
         }
         index_reversed[LANES..].fill(b.index_reversed);
         a.take_pair_half(b, &scrambled_sobol(&index_reversed, &seeds));
@@ -439,12 +433,103 @@ fn scrambled_sobol<const N: usize>(
     values
 }
 
-/// `N` Sobol dimensions' values of a sample, per coordinate (as they are computed, side by
-/// side).
+/// `N` points side by side, per coordinate: a sampler's window (`N` Sobol dimensions' values
+/// of its sample) or the points of `N` lanes' samples ([`camera_points`]).
 #[derive(Debug, Clone)]
-struct Window<const N: usize> {
-    x: [f32; N],
-    y: [f32; N],
+pub struct Window<const N: usize> {
+    /// The points' first coordinates.
+    pub x: [f32; N],
+    /// Their second.
+    pub y: [f32; N],
+}
+
+/// The camera's first `dimensions` (one or two: the film's point, then the lens's) of the
+/// new samplers (at dimension 0) of `lanes`, lane `l`'s drawn by `samplers[l]` as `next_2d`
+/// would draw them: `points[d]` holds dimension `d`'s. Sobol's are computed [`LANES`] side by
+/// side, the lanes' values packed together (a packet's few new paths cost a few lanes' work,
+/// not a packet's), from the seeds each sampler keeps; each sampler goes on past them, its
+/// first window (from dimension 0, the dimensions drawn here in it unused) still due, for
+/// [`Sampler::prepare_first`] once the path is known to go on: a camera ray that meets
+/// nothing computes no window.
+#[inline(always)]
+pub fn camera_points(
+    samplers: &mut [Sampler; PACKET],
+    lanes: Lanes,
+    dimensions: usize,
+) -> [Window<PACKET>; 2] {
+    /// Groups of [`LANES`] values, enough for two dimensions of every lane.
+    const GROUPS: usize = 2 * PACKET / LANES;
+    let mut points = [const {
+        Window {
+            x: [0.0; PACKET],
+            y: [0.0; PACKET],
+        }
+    }; 2];
+    // The samplers of a row are all of one kind.
+    let Some(first) = samplers.get(lanes.trailing_zeros() as usize) else {
+        return points; // No lanes.
+    };
+    if first.kind != SAMPLER_SOBOL {
+        for_each_lane(lanes, |l| {
+            for point in &mut points[..dimensions] {
+                let value = samplers[l].next_2d();
+                (point.x[l], point.y[l]) = (value.x, value.y);
+            }
+        });
+        return points;
+    }
+    // Value `k` (lane by lane, each lane's dimensions in turn) is element `k % LANES` of
+    // group `k / LANES`.
+    let mut index_reversed = [[0; LANES]; GROUPS];
+    let mut seeds = [const {
+        ScrambleSeeds {
+            index: [0; LANES],
+            x: [0; LANES],
+            y: [0; LANES],
+        }
+    }; GROUPS];
+    let mut count = 0;
+    for_each_lane(lanes, |l| {
+        let sampler = &mut samplers[l];
+        debug_assert_eq!(sampler.dimension, 0, "not a new sampler");
+        for d in 0..dimensions {
+            let (group, i) = (count / LANES, count % LANES);
+            index_reversed[group][i] = sampler.index_reversed;
+            seeds[group].index[i] = sampler.first_seeds.index[d];
+            seeds[group].x[i] = sampler.first_seeds.x[d];
+            seeds[group].y[i] = sampler.first_seeds.y[d];
+            count += 1;
+        }
+        sampler.dimension = dimensions as u32;
+    });
+    let mut values = [const {
+        Window {
+            x: [0.0; LANES],
+            y: [0.0; LANES],
+        }
+    }; GROUPS];
+    for group in 0..count.div_ceil(LANES) {
+        values[group] = scrambled_sobol(&index_reversed[group], &seeds[group]);
+    }
+    let mut k = 0;
+    for_each_lane(lanes, |l| {
+        for point in &mut points[..dimensions] {
+            let (group, i) = (k / LANES, k % LANES);
+            (point.x[l], point.y[l]) = (values[group].x[i], values[group].y[i]);
+            k += 1;
+        }
+    });
+    points
+}
+
+/// Calls `f` with each lane of `lanes`, lowest first.
+#[inline(always)]
+fn for_each_lane(mut lanes: Lanes, mut f: impl FnMut(usize)) {
+    while lanes != 0 {
+        let l = lanes.trailing_zeros() as usize;
+        lanes &= lanes - 1;
+        f(l);
+    }
 }
 
 #[cfg(test)]
@@ -568,27 +653,58 @@ mod tests {
 
     #[test]
     fn first_windows_from_the_pixels_seeds_draw_what_new_samplers_draw() {
-        // A pixel's samplers, their first windows computed from the scrambles' seeds it
-        // keeps (alone, or two side by side of the same or of two pixels), draw what
+        // A pixel's samplers, their first windows computed from the scrambles' seeds they
+        // keep (alone, or two side by side of the same or of two pixels), draw what
         // `Sampler::new` draws, past the first window too; the independent kind is untouched.
         let draws = BOUNCE_DRAWS;
         for kind in [SAMPLER_SOBOL, SAMPLER_INDEPENDENT] {
             let pixels = [17, 18].map(|pixel| PixelSamplers::new(kind, pixel, 9));
             for (index_a, index_b, pixel_b) in [(3, 4, 0), (3, 5, 1), (0, 1 << 20, 1)] {
-                let (pixel_a, pixel_b) = (&pixels[0], &pixels[pixel_b]);
-                let mut a = pixel_a.sampler(index_a);
+                let pixel_b = &pixels[pixel_b];
+                let mut a = pixels[0].sampler(index_a);
                 let mut b = pixel_b.sampler(index_b);
-                let mut alone = pixel_a.sampler(index_a);
+                let mut alone = pixels[0].sampler(index_a);
                 let mut new_a = Sampler::new(kind, 17, index_a, 9);
                 let mut new_b = Sampler::new(kind, pixel_b.pixel, index_b, 9);
-                Sampler::prepare_first_pair(&mut a, pixel_a, &mut b, pixel_b);
-                alone.prepare_first(pixel_a);
+                Sampler::prepare_first_pair(&mut a, &mut b);
+                alone.prepare_first();
                 assert!(!a.window_due() && !b.window_due() && !alone.window_due());
                 for _ in 0..3 {
                     let expected = new_a.next_batch(draws);
                     assert_eq!(a.next_batch(draws), expected, "{kind} {index_a}");
                     assert_eq!(alone.next_batch(draws), expected, "{kind} {index_a}");
                     assert_eq!(b.next_batch(draws), new_b.next_batch(draws), "{index_b}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn camera_points_are_what_each_sampler_draws_one_by_one() {
+        // New samplers of several pixels in some lanes: the camera's one or two points drawn
+        // side by side are each sampler's first `next_2d`s, and the samplers go on (their
+        // first window computed from their seeds, or by the next draw) as they would have.
+        let lanes: Lanes = 0b1011_0000_0000_0110_0000_0001_1100_0101;
+        for kind in [SAMPLER_SOBOL, SAMPLER_INDEPENDENT] {
+            for dimensions in [1, 2] {
+                let fresh = |l: usize| {
+                    PixelSamplers::new(kind, 40 + l as u32 / 3, 7).sampler(l as u32 * 5 + 1)
+                };
+                let mut samplers: [Sampler; PACKET] = std::array::from_fn(fresh);
+                let points = camera_points(&mut samplers, lanes, dimensions);
+                for l in (0..PACKET).filter(|l| lanes >> l & 1 == 1) {
+                    let mut alone = fresh(l);
+                    for (d, point) in points.iter().enumerate().take(dimensions) {
+                        let drawn = Vec2::new(point.x[l], point.y[l]);
+                        assert_eq!(drawn, alone.next_2d(), "{kind}: lane {l}, dimension {d}");
+                    }
+                    let mut prepared = samplers[l].clone();
+                    prepared.prepare_first();
+                    for _ in 0..3 {
+                        let expected = alone.next_batch(BOUNCE_DRAWS);
+                        assert_eq!(samplers[l].next_batch(BOUNCE_DRAWS), expected, "lane {l}");
+                        assert_eq!(prepared.next_batch(BOUNCE_DRAWS), expected, "lane {l}");
+                    }
                 }
             }
         }
