@@ -3,7 +3,7 @@
 
 use std::ops::Range;
 
-use glam::{Vec2, Vec3, Vec3A};
+use glam::{Vec3, Vec3A};
 use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams};
 
 use crate::bsdf_lanes::{LaneBsdf, SampleLanes};
@@ -14,7 +14,7 @@ use crate::integrator::{
 };
 use crate::intersect::Ray;
 use crate::packet::{Lanes, PACKET, PacketHits, RayPacket};
-use crate::sampler::{PixelSamplers, Sampler, camera_points};
+use crate::sampler::{CameraPoints, PixelSamplers, Sampler};
 use crate::tracer::Tracer;
 
 /// A row's running sums: the colour's, and the auxiliary images' (empty when the render has
@@ -268,10 +268,10 @@ fn leave_sampled<M: LaneBsdf>(
 }
 
 /// The samples of a row still to start (pixel by pixel, each pixel's in turn), and what
-/// starting them needs: a new path's sampler is made lane by lane, then the camera's sample
-/// values ([`camera_points`]) and (for a pinhole) the camera rays of all the lanes starting at
-/// once, side by side, so that new paths do not each wait on hash chains, a division and a
-/// square root.
+/// starting them needs: a new path's sampler is started lane by lane, then the camera's
+/// sample values ([`CameraPoints`]) and (for a pinhole) the camera rays of all the lanes
+/// starting at once, side by side, so that new paths do not each wait on hash chains, a
+/// division and a square root.
 struct Starter<'a> {
     job: &'a RowJob<'a>,
     width: usize,
@@ -281,6 +281,8 @@ struct Starter<'a> {
     pixel: PixelSamplers,
     index: u32,
     pinhole: bool,
+    /// The camera's sample values of the samples starting.
+    camera: CameraPoints,
     /// Per lane, of the sample starting there: its film point (for a pinhole) or camera ray
     /// (with a lens).
     film_x: [f32; PACKET],
@@ -299,6 +301,11 @@ impl<'a> Starter<'a> {
             pixel: PixelSamplers::new(params.sampler, job.y * params.width, params.seed),
             index: job.samples.start,
             pinhole: params.camera.lens_radius <= 0.0,
+            camera: CameraPoints::new(if params.camera.lens_radius <= 0.0 {
+                1
+            } else {
+                2
+            }),
             film_x: [0.0; PACKET],
             film_y: [0.0; PACKET],
             lens_rays: RayPacket::default().rays,
@@ -329,7 +336,8 @@ impl<'a> Starter<'a> {
             while empty != 0 && self.column != self.width {
                 let l = empty.trailing_zeros() as usize;
                 empty &= empty - 1;
-                lanes.samplers[l] = self.pixel.sampler(self.index);
+                let sampler = &mut lanes.samplers[l];
+                self.camera.start(sampler, &self.pixel, self.index);
                 lanes.columns[l] = self.column;
                 starting |= 1 << l;
                 self.index += 1;
@@ -345,24 +353,22 @@ impl<'a> Starter<'a> {
             if starting == 0 {
                 return tally;
             }
-            let [jitter, lens] = camera_points(
-                &mut lanes.samplers,
-                starting,
-                if self.pinhole { 1 } else { 2 },
-            );
+            self.camera.draw(params.sampler);
             let mut left = starting;
+            // The samples in the order they started.
+            let mut n = 0;
             while left != 0 {
                 let l = left.trailing_zeros() as usize;
                 left &= left - 1;
-                let jitter = Vec2::new(jitter.x[l], jitter.y[l]);
-                let film = film_point(lanes.columns[l] as u32, job.y, jitter);
+                let film = film_point(lanes.columns[l] as u32, job.y, self.camera.point(n, 0));
                 if self.pinhole {
                     (self.film_x[l], self.film_y[l]) = (film.x, film.y);
                 } else {
-                    let u = Vec2::new(lens.x[l], lens.y[l]);
-                    self.lens_rays[l] = lens_ray(params, film, u);
+                    self.lens_rays[l] = lens_ray(params, film, self.camera.point(n, 1));
                 }
+                n += 1;
             }
+            self.camera.clear();
             let dir = self
                 .pinhole
                 .then(|| primary_directions(params, &self.film_x, &self.film_y));

@@ -10,7 +10,7 @@
 use glam::Vec2;
 use pathlight_core::gpu_types::SAMPLER_SOBOL;
 
-use crate::packet::{Lanes, PACKET};
+use crate::packet::PACKET;
 
 /// PCG hash (Jarzynski and Olano, JCGT 2020). Twin of WGSL `pcg_hash`.
 pub const fn pcg_hash(v: u32) -> u32 {
@@ -183,26 +183,22 @@ impl PixelSamplers {
     /// The sampler of sample `index` of this pixel: [`Sampler::new`]'s.
     #[inline(always)]
     pub fn sampler(&self, index: u32) -> Sampler {
-        let sobol = self.kind == SAMPLER_SOBOL;
-        Sampler {
+        let mut sampler = Sampler {
             kind: self.kind,
-            pixel_seed: self.pixel_seed,
-            index_reversed: index.reverse_bits(),
+            pixel_seed: 0,
+            index_reversed: 0,
             dimension: 0,
-            rng_state: if sobol {
-                0
-            } else {
-                rng_init(self.pixel, index, self.seed)
-            },
+            rng_state: 0,
             ahead: Window {
                 x: [0.0; LANES],
                 y: [0.0; LANES],
             },
             first_seeds: self.first_seeds,
-            // The camera's dimensions and the first bounce's come from the window at 0.
             ahead_from: 0,
-            due: sobol,
-        }
+            due: false,
+        };
+        sampler.restart(self, index);
+        sampler
     }
 }
 
@@ -211,6 +207,26 @@ impl Sampler {
     #[inline(always)]
     pub fn new(kind: u32, pixel: u32, index: u32, seed: u32) -> Self {
         PixelSamplers::new(kind, pixel, seed).sampler(index)
+    }
+
+    /// Makes this sampler [`PixelSamplers::sampler`]'s of `pixel` for sample `index`, its
+    /// window left as it is (due: no draw reads it before it is computed anew).
+    #[inline(always)]
+    pub fn restart(&mut self, pixel: &PixelSamplers, index: u32) {
+        let sobol = pixel.kind == SAMPLER_SOBOL;
+        self.kind = pixel.kind;
+        self.pixel_seed = pixel.pixel_seed;
+        self.index_reversed = index.reverse_bits();
+        self.dimension = 0;
+        self.rng_state = if sobol {
+            0
+        } else {
+            rng_init(pixel.pixel, index, pixel.seed)
+        };
+        self.first_seeds = pixel.first_seeds;
+        // The camera's dimensions and the first bounce's come from the window at 0.
+        self.ahead_from = 0;
+        self.due = sobol;
     }
 
     /// Sobol: the seed of `pixel` under `seed` (each kind hashes only the state it reads;
@@ -434,101 +450,110 @@ fn scrambled_sobol<const N: usize>(
 }
 
 /// `N` points side by side, per coordinate: a sampler's window (`N` Sobol dimensions' values
-/// of its sample) or the points of `N` lanes' samples ([`camera_points`]).
+/// of its sample), or values of several samples ([`CameraPoints`]).
 #[derive(Debug, Clone)]
-pub struct Window<const N: usize> {
-    /// The points' first coordinates.
-    pub x: [f32; N],
-    /// Their second.
-    pub y: [f32; N],
+struct Window<const N: usize> {
+    x: [f32; N],
+    y: [f32; N],
 }
 
-/// The camera's first `dimensions` (one or two: the film's point, then the lens's) of the
-/// new samplers (at dimension 0) of `lanes`, lane `l`'s drawn by `samplers[l]` as `next_2d`
-/// would draw them: `points[d]` holds dimension `d`'s. Sobol's are computed [`LANES`] side by
-/// side, the lanes' values packed together (a packet's few new paths cost a few lanes' work,
-/// not a packet's), from the seeds each sampler keeps; each sampler goes on past them, its
-/// first window (from dimension 0, the dimensions drawn here in it unused) still due, for
-/// [`Sampler::prepare_first`] once the path is known to go on: a camera ray that meets
-/// nothing computes no window.
-#[inline(always)]
-pub fn camera_points(
-    samplers: &mut [Sampler; PACKET],
-    lanes: Lanes,
+/// Groups of [`LANES`] values in [`CameraPoints`], enough for two dimensions of every lane of
+/// a packet.
+const CAMERA_GROUPS: usize = 2 * PACKET / LANES;
+
+/// The camera's sample values (the film's point, then the lens's if there is one) of a
+/// packet's new samplers, gathered as they start ([`CameraPoints::start`]) and then drawn all
+/// at once ([`CameraPoints::draw`]): Sobol's [`LANES`] side by side, packed together, so that
+/// a packet's few new paths cost a few lanes' work, not a packet's, and no path waits on its
+/// own hash chain. Each sampler goes on past them, its first window (from dimension 0, the
+/// dimensions drawn here in it unused) still due, for [`Sampler::prepare_first`] once the path
+/// is known to go on: a camera ray that meets nothing computes no window.
+pub struct CameraPoints {
+    /// The camera's dimensions: 1 or 2.
     dimensions: usize,
-) -> [Window<PACKET>; 2] {
-    /// Groups of [`LANES`] values, enough for two dimensions of every lane.
-    const GROUPS: usize = 2 * PACKET / LANES;
-    let mut points = [const {
-        Window {
-            x: [0.0; PACKET],
-            y: [0.0; PACKET],
-        }
-    }; 2];
-    // The samplers of a row are all of one kind.
-    let Some(first) = samplers.get(lanes.trailing_zeros() as usize) else {
-        return points; // No lanes.
-    };
-    if first.kind != SAMPLER_SOBOL {
-        for_each_lane(lanes, |l| {
-            for point in &mut points[..dimensions] {
-                let value = samplers[l].next_2d();
-                (point.x[l], point.y[l]) = (value.x, value.y);
-            }
-        });
-        return points;
-    }
-    // Value `k` (lane by lane, each lane's dimensions in turn) is element `k % LANES` of
-    // group `k / LANES`.
-    let mut index_reversed = [[0; LANES]; GROUPS];
-    let mut seeds = [const {
-        ScrambleSeeds {
-            index: [0; LANES],
-            x: [0; LANES],
-            y: [0; LANES],
-        }
-    }; GROUPS];
-    let mut count = 0;
-    for_each_lane(lanes, |l| {
-        let sampler = &mut samplers[l];
-        debug_assert_eq!(sampler.dimension, 0, "not a new sampler");
-        for d in 0..dimensions {
-            let (group, i) = (count / LANES, count % LANES);
-            index_reversed[group][i] = sampler.index_reversed;
-            seeds[group].index[i] = sampler.first_seeds.index[d];
-            seeds[group].x[i] = sampler.first_seeds.x[d];
-            seeds[group].y[i] = sampler.first_seeds.y[d];
-            count += 1;
-        }
-        sampler.dimension = dimensions as u32;
-    });
-    let mut values = [const {
-        Window {
-            x: [0.0; LANES],
-            y: [0.0; LANES],
-        }
-    }; GROUPS];
-    for group in 0..count.div_ceil(LANES) {
-        values[group] = scrambled_sobol(&index_reversed[group], &seeds[group]);
-    }
-    let mut k = 0;
-    for_each_lane(lanes, |l| {
-        for point in &mut points[..dimensions] {
-            let (group, i) = (k / LANES, k % LANES);
-            (point.x[l], point.y[l]) = (values[group].x[i], values[group].y[i]);
-            k += 1;
-        }
-    });
-    points
+    /// Values gathered.
+    count: usize,
+    /// Sobol: value `k` (sampler by sampler, each one's dimensions in turn) is element
+    /// `k % LANES` of group `k / LANES`: its sample's reversed index, its dimension's seeds.
+    index_reversed: [[u32; LANES]; CAMERA_GROUPS],
+    seeds: [ScrambleSeeds<LANES>; CAMERA_GROUPS],
+    /// The values, once drawn (the independent kind's as each sampler starts).
+    values: [Window<LANES>; CAMERA_GROUPS],
 }
 
-/// Calls `f` with each lane of `lanes`, lowest first.
-#[inline(always)]
-fn for_each_lane(mut lanes: Lanes, mut f: impl FnMut(usize)) {
-    while lanes != 0 {
-        let l = lanes.trailing_zeros() as usize;
-        lanes &= lanes - 1;
-        f(l);
+impl CameraPoints {
+    /// None gathered yet, of a camera drawing `dimensions` (1 or 2) points.
+    #[inline(always)]
+    pub fn new(dimensions: usize) -> Self {
+        debug_assert!((1..=2).contains(&dimensions));
+        Self {
+            dimensions,
+            count: 0,
+            index_reversed: [[0; LANES]; CAMERA_GROUPS],
+            seeds: [const {
+                ScrambleSeeds {
+                    index: [0; LANES],
+                    x: [0; LANES],
+                    y: [0; LANES],
+                }
+            }; CAMERA_GROUPS],
+            values: [const {
+                Window {
+                    x: [0.0; LANES],
+                    y: [0.0; LANES],
+                }
+            }; CAMERA_GROUPS],
+        }
+    }
+
+    /// Starts `sampler` as sample `index` of `pixel` ([`Sampler::restart`]) and gathers its
+    /// camera's points, the next ones [`CameraPoints::point`] gives. At most [`PACKET`]
+    /// samplers between two [`CameraPoints::clear`]s.
+    #[inline(always)]
+    pub fn start(&mut self, sampler: &mut Sampler, pixel: &PixelSamplers, index: u32) {
+        sampler.restart(pixel, index);
+        for d in 0..self.dimensions {
+            let (group, i) = (self.count / LANES, self.count % LANES);
+            if pixel.kind == SAMPLER_SOBOL {
+                self.index_reversed[group][i] = sampler.index_reversed;
+                self.seeds[group].index[i] = pixel.first_seeds.index[d];
+                self.seeds[group].x[i] = pixel.first_seeds.x[d];
+                self.seeds[group].y[i] = pixel.first_seeds.y[d];
+            } else {
+                let value = sampler.next_2d();
+                (self.values[group].x[i], self.values[group].y[i]) = (value.x, value.y);
+            }
+            self.count += 1;
+        }
+        if pixel.kind == SAMPLER_SOBOL {
+            sampler.dimension = self.dimensions as u32;
+        }
+    }
+
+    /// Draws the Sobol values gathered (of the samplers of `kind`, `SAMPLER_*`).
+    #[inline(always)]
+    pub fn draw(&mut self, kind: u32) {
+        if kind == SAMPLER_SOBOL {
+            for group in 0..self.count.div_ceil(LANES) {
+                self.values[group] =
+                    scrambled_sobol(&self.index_reversed[group], &self.seeds[group]);
+            }
+        }
+    }
+
+    /// Dimension `d` of the camera's points of the `n`th sampler started since the last
+    /// [`CameraPoints::clear`], once drawn.
+    #[inline(always)]
+    pub fn point(&self, n: usize, d: usize) -> Vec2 {
+        let k = n * self.dimensions + d;
+        let (group, i) = (k / LANES, k % LANES);
+        Vec2::new(self.values[group].x[i], self.values[group].y[i])
+    }
+
+    /// Forgets the samplers started (their points read).
+    #[inline(always)]
+    pub fn clear(&mut self) {
+        self.count = 0;
     }
 }
 
@@ -681,30 +706,43 @@ mod tests {
 
     #[test]
     fn camera_points_are_what_each_sampler_draws_one_by_one() {
-        // New samplers of several pixels in some lanes: the camera's one or two points drawn
-        // side by side are each sampler's first `next_2d`s, and the samplers go on (their
-        // first window computed from their seeds, or by the next draw) as they would have.
-        let lanes: Lanes = 0b1011_0000_0000_0110_0000_0001_1100_0101;
+        // Samplers of several pixels started over used ones (two packets' worth, the second
+        // after a clear): the camera's one or two points drawn side by side are each new
+        // sampler's first `next_2d`s, and the samplers go on (their first window computed
+        // from their seeds, or by the next draw) as they would have.
         for kind in [SAMPLER_SOBOL, SAMPLER_INDEPENDENT] {
             for dimensions in [1, 2] {
-                let fresh = |l: usize| {
-                    PixelSamplers::new(kind, 40 + l as u32 / 3, 7).sampler(l as u32 * 5 + 1)
-                };
-                let mut samplers: [Sampler; PACKET] = std::array::from_fn(fresh);
-                let points = camera_points(&mut samplers, lanes, dimensions);
-                for l in (0..PACKET).filter(|l| lanes >> l & 1 == 1) {
-                    let mut alone = fresh(l);
-                    for (d, point) in points.iter().enumerate().take(dimensions) {
-                        let drawn = Vec2::new(point.x[l], point.y[l]);
-                        assert_eq!(drawn, alone.next_2d(), "{kind}: lane {l}, dimension {d}");
+                let mut camera = CameraPoints::new(dimensions);
+                for round in 0..2 {
+                    let count = [PACKET, 11][round];
+                    let pixel = |i: usize| PixelSamplers::new(kind, 40 + i as u32 / 3, 7);
+                    let index = |i: usize| (i * 5 + round) as u32;
+                    let mut samplers: Vec<Sampler> = (0..count)
+                        .map(|i| {
+                            let mut used = Sampler::new(kind, 99, 1234, 5);
+                            used.next_batch(BOUNCE_DRAWS);
+                            used
+                        })
+                        .collect();
+                    for (i, sampler) in samplers.iter_mut().enumerate() {
+                        camera.start(sampler, &pixel(i), index(i));
                     }
-                    let mut prepared = samplers[l].clone();
-                    prepared.prepare_first();
-                    for _ in 0..3 {
-                        let expected = alone.next_batch(BOUNCE_DRAWS);
-                        assert_eq!(samplers[l].next_batch(BOUNCE_DRAWS), expected, "lane {l}");
-                        assert_eq!(prepared.next_batch(BOUNCE_DRAWS), expected, "lane {l}");
+                    camera.draw(kind);
+                    for (i, sampler) in samplers.iter_mut().enumerate() {
+                        let mut alone = pixel(i).sampler(index(i));
+                        for d in 0..dimensions {
+                            let drawn = camera.point(i, d);
+                            assert_eq!(drawn, alone.next_2d(), "{kind}: sample {i}, dimension {d}");
+                        }
+                        let mut prepared = sampler.clone();
+                        prepared.prepare_first();
+                        for _ in 0..3 {
+                            let expected = alone.next_batch(BOUNCE_DRAWS);
+                            assert_eq!(sampler.next_batch(BOUNCE_DRAWS), expected, "{i}");
+                            assert_eq!(prepared.next_batch(BOUNCE_DRAWS), expected, "{i}");
+                        }
                     }
+                    camera.clear();
                 }
             }
         }
