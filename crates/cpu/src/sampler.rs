@@ -718,7 +718,7 @@ mod tests {
                     let pixel = |i: usize| PixelSamplers::new(kind, 40 + i as u32 / 3, 7);
                     let index = |i: usize| (i * 5 + round) as u32;
                     let mut samplers: Vec<Sampler> = (0..count)
-                        .map(|i| {
+                        .map(|_| {
                             let mut used = Sampler::new(kind, 99, 1234, 5);
                             used.next_batch(BOUNCE_DRAWS);
                             used
