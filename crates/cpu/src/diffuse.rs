@@ -28,6 +28,9 @@ use crate::packet::{Lanes, PACKET};
 use crate::sampling::{power_heuristic, sin_cos_turns};
 use crate::soa::{Lanes3, dot, frame_around, lane, set_lane, to_world};
 
+/// Slots [`DiffuseLanes::compute`] computes at once: one AVX2 register of `f32`s.
+const GROUP: usize = 8;
+
 /// A diffuse vertex with its BSDF sample, and what the path needs to go on from it.
 #[derive(Debug, Clone, Copy)]
 pub struct DiffuseVertex {
@@ -48,12 +51,19 @@ pub struct DiffuseVertex {
 }
 
 /// Per lane, a diffuse vertex waiting for the rest of its bounce ([`DiffuseLanes::push`]),
-/// and after [`DiffuseLanes::compute`] its results ([`DiffuseLanes::vertex`]).
+/// and after [`DiffuseLanes::compute`] its results ([`DiffuseLanes::vertex`]). The waiting
+/// lanes' values are packed in slots, in the order the lanes come, so that `compute` works
+/// on as many groups of [`GROUP`] slots as there are lanes waiting, not on the whole packet
+/// (a packet with a third of its paths on diffuse surfaces costs half the work).
 #[derive(Debug, Clone)]
 pub struct DiffuseLanes {
     /// Bit `l` set: lane `l` waits (or, after `compute`, has its results).
     pub mask: Lanes,
-    // Inputs.
+    /// Lanes waiting, and each waiting lane's slot: the index of its values below (and in
+    /// the bit masks below).
+    count: usize,
+    slots: [u8; PACKET],
+    // Inputs, per slot.
     position: Lanes3,
     /// The shading and geometric normals, on the side of `wo`.
     n: Lanes3,
@@ -63,11 +73,11 @@ pub struct DiffuseLanes {
     /// The two dimensions the BSDF direction is drawn from, and Russian roulette's.
     u: [[f32; PACKET]; 2],
     u_rr: [f32; PACKET],
-    /// Bit `l` set: lane `l`'s light sample is of a constant environment instead
+    /// Bit `k` set: slot `k`'s light sample is of a constant environment instead
     /// ([`DiffuseLanes::push_sky_light`]), of probability `sky_pmf`.
     sky_light: Lanes,
     sky_pmf: f32,
-    /// Bit `l` set: lane `l`'s light sample is on a quad light, and waits too
+    /// Bit `k` set: slot `k`'s light sample is on a quad light, and waits too
     /// ([`DiffuseLanes::push_quad_light`]).
     quad_light: Lanes,
     /// The quad (corner, edges, unit normal, area), the probability of having chosen it, its
@@ -79,9 +89,9 @@ pub struct DiffuseLanes {
     u_light: [[f32; PACKET]; 2],
     throughput: Lanes3,
     /// The light samples taken elsewhere, given to lanes ([`DiffuseLanes::push_light`]), and
-    /// after `compute` the evaluations towards them.
+    /// after `compute` the evaluations towards them, by slot.
     given: LightLanes,
-    // Outputs.
+    // Outputs, per slot.
     lit: [bool; PACKET],
     shadow_origin: Lanes3,
     shadow_dir: Lanes3,
@@ -98,6 +108,8 @@ impl Default for DiffuseLanes {
         let zero = [[0.0; PACKET]; 3];
         Self {
             mask: 0,
+            count: 0,
+            slots: [0; PACKET],
             position: zero,
             n: zero,
             ng: zero,
@@ -141,16 +153,35 @@ impl DiffuseLanes {
     #[inline(always)]
     pub fn clear(&mut self) {
         self.mask = 0;
+        self.count = 0;
         self.quad_light = 0;
         self.sky_light = 0;
         self.given.clear();
+    }
+
+    /// Lane `l`'s slot, given it now if it has none: it waits from now on.
+    #[inline(always)]
+    fn take_slot(&mut self, l: usize) -> usize {
+        if self.mask >> l & 1 == 0 {
+            self.slots[l] = self.count as u8;
+            self.count += 1;
+            self.mask |= 1 << l;
+        }
+        self.slot(l)
+    }
+
+    /// The slot of lane `l`, which waits.
+    #[inline(always)]
+    fn slot(&self, l: usize) -> usize {
+        usize::from(self.slots[l])
     }
 
     /// Lane `l` (also [`DiffuseLanes::push`]ed) has the valid light sample `ls`, taken
     /// elsewhere: the BSDF is evaluated towards it.
     #[inline(always)]
     pub fn push_light(&mut self, l: usize, ls: &LightSample) {
-        self.given.push(l, ls);
+        let k = self.slot(l);
+        self.given.push(k, ls);
     }
 
     /// Lane `l` waits at `position`, whose Lambert lobe of colour `color` has shading normal
@@ -172,15 +203,15 @@ impl DiffuseLanes {
         u: Vec2,
         u_rr: f32,
     ) {
-        set_lane(&mut self.position, l, position);
-        set_lane(&mut self.n, l, n);
-        set_lane(&mut self.ng, l, ng);
-        set_lane(&mut self.wo, l, wo);
-        set_lane(&mut self.color, l, color);
-        self.u[0][l] = u.x;
-        self.u[1][l] = u.y;
-        self.u_rr[l] = u_rr;
-        self.mask |= 1 << l;
+        let k = self.take_slot(l);
+        set_lane(&mut self.position, k, position);
+        set_lane(&mut self.n, k, n);
+        set_lane(&mut self.ng, k, ng);
+        set_lane(&mut self.wo, k, wo);
+        set_lane(&mut self.color, k, color);
+        self.u[0][k] = u.x;
+        self.u[1][k] = u.y;
+        self.u_rr[k] = u_rr;
     }
 
     /// Lane `l` (also [`DiffuseLanes::push`]ed) samples quad `object` of `scene`, chosen with
@@ -196,23 +227,24 @@ impl DiffuseLanes {
         u_light: Vec2,
         throughput: Vec3A,
     ) {
+        let k = self.take_slot(l);
         let o = &scene.objects[object as usize];
         let corners = [o.a, o.b, o.c].map(|v| Vec3A::from_slice(&v));
         for (quad, v) in self.quad.iter_mut().zip(corners) {
-            set_lane(quad, l, v);
+            set_lane(quad, k, v);
         }
-        set_lane(&mut self.quad[3], l, scene.quad_normal(object));
-        self.quad_area[l] = scene.quad_area(object);
-        self.quad_pmf[l] = pmf;
+        set_lane(&mut self.quad[3], k, scene.quad_normal(object));
+        self.quad_area[k] = scene.quad_area(object);
+        self.quad_pmf[k] = pmf;
         set_lane(
             &mut self.emission,
-            l,
+            k,
             Vec3A::from(scene.materials[o.material as usize].emission),
         );
-        self.u_light[0][l] = u_light.x;
-        self.u_light[1][l] = u_light.y;
-        set_lane(&mut self.throughput, l, throughput);
-        self.quad_light |= 1 << l;
+        self.u_light[0][k] = u_light.x;
+        self.u_light[1][k] = u_light.y;
+        set_lane(&mut self.throughput, k, throughput);
+        self.quad_light |= 1 << k;
     }
 
     /// Lane `l` (also [`DiffuseLanes::push`]ed) samples the constant environment of radiance
@@ -227,28 +259,41 @@ impl DiffuseLanes {
         u_light: Vec2,
         throughput: Vec3A,
     ) {
-        set_lane(&mut self.emission, l, radiance);
+        let k = self.take_slot(l);
+        set_lane(&mut self.emission, k, radiance);
         self.sky_pmf = pmf;
-        self.u_light[0][l] = u_light.x;
-        self.u_light[1][l] = u_light.y;
-        set_lane(&mut self.throughput, l, throughput);
-        self.sky_light |= 1 << l;
+        self.u_light[0][k] = u_light.x;
+        self.u_light[1][k] = u_light.y;
+        set_lane(&mut self.throughput, k, throughput);
+        self.sky_light |= 1 << k;
     }
 
-    /// Computes every lane side by side (those not waiting compute throw-away values).
+    /// Computes the waiting lanes' slots side by side, in as many groups of [`GROUP`] as
+    /// they fill (the rest of the last group computes throw-away values).
     #[inline(always)]
     pub fn compute(&mut self) {
-        // The quads' loop writes every lane; the sky's then its own lanes only, where there
+        match self.count.div_ceil(GROUP) {
+            0 | 1 => self.compute_slots::<GROUP>(),
+            2 => self.compute_slots::<{ 2 * GROUP }>(),
+            3 => self.compute_slots::<{ 3 * GROUP }>(),
+            _ => self.compute_slots::<PACKET>(),
+        }
+    }
+
+    /// [`DiffuseLanes::compute`] of the first `N` slots, a count the loops know.
+    #[inline(always)]
+    fn compute_slots<const N: usize>(&mut self) {
+        // The quads' loop writes every slot; the sky's then its own slots only, where there
         // are both.
         if self.quad_light != 0 {
-            self.light_quads();
+            self.light_quads::<N>();
         }
         match (self.sky_light != 0, self.quad_light != 0) {
-            (true, true) => self.light_skies::<true>(),
-            (true, false) => self.light_skies::<false>(),
+            (true, true) => self.light_skies::<true, N>(),
+            (true, false) => self.light_skies::<false, N>(),
             _ => {}
         }
-        for l in 0..PACKET {
+        for l in 0..N {
             let at = |a: &Lanes3| [a[0][l], a[1][l], a[2][l]];
             let (n, ng, wo) = (at(&self.n), at(&self.ng), at(&self.wo));
             // The BSDF sample: `sample_cosine_hemisphere`, turned by `Frame::around(n)`.
@@ -268,7 +313,7 @@ impl DiffuseLanes {
             self.pdf[l] = pdf;
         }
         if self.given.mask != 0 {
-            for l in 0..PACKET {
+            for l in 0..N {
                 let at = |a: &Lanes3| [a[0][l], a[1][l], a[2][l]];
                 let (n, ng, wo, wi) = (at(&self.n), at(&self.ng), at(&self.wo), at(&self.given.wi));
                 // `eval_lobes` of the Lambert lobe alone, as `next_event` computes it.
@@ -288,8 +333,8 @@ impl DiffuseLanes {
     /// `Path::step` does with it: `eval_lobes` of the Lambert lobe alone, `power_heuristic`,
     /// `shadow_ray`.
     #[inline(always)]
-    fn light_quads(&mut self) {
-        for l in 0..PACKET {
+    fn light_quads<const N: usize>(&mut self) {
+        for l in 0..N {
             let at = |a: &Lanes3| [a[0][l], a[1][l], a[2][l]];
             let p = at(&self.position);
             let [a, b, c, normal] = self.quad.each_ref().map(at);
@@ -315,10 +360,10 @@ impl DiffuseLanes {
 
     /// The constant environment's samples side by side: `sample_environment` without a map
     /// (a cosine-weighted direction about `n`), then what `Path::step` does with it, as
-    /// [`DiffuseLanes::light_quads`]; `MASKED`: leaving the other lanes' results as they are.
+    /// [`DiffuseLanes::light_quads`]; `MASKED`: leaving the other slots' results as they are.
     #[inline(always)]
-    fn light_skies<const MASKED: bool>(&mut self) {
-        for l in 0..PACKET {
+    fn light_skies<const MASKED: bool, const N: usize>(&mut self) {
+        for l in 0..N {
             let n = [self.n[0][l], self.n[1][l], self.n[2][l]];
             let frame = frame_around(n);
             let local = cosine_hemisphere(self.u_light[0][l], self.u_light[1][l]);
@@ -399,6 +444,7 @@ impl DiffuseLanes {
     /// Lane `l`'s results, once [`DiffuseLanes::compute`] ran.
     #[inline(always)]
     pub fn vertex(&self, l: usize) -> DiffuseVertex {
+        let l = self.slot(l);
         let sample = if self.valid[l] {
             BsdfSample {
                 wi: lane(&self.wi, l),
@@ -431,6 +477,7 @@ impl DiffuseLanes {
     /// one, and the BSDF's evaluation towards it, once [`DiffuseLanes::compute`] ran.
     #[inline(always)]
     pub fn given_light(&self, l: usize) -> Option<LitVertex<'_>> {
+        let l = self.slot(l);
         let (position, ng) = (lane(&self.position, l), lane(&self.ng, l));
         self.given.lit(l, position, ng)
     }
@@ -470,12 +517,28 @@ mod tests {
         }
     }
 
+    /// The lanes a round of the tests pushes, in the order pushed: all of them, or some (so
+    /// that the slots in use end within each group of eight, and no slot is its lane), in
+    /// rising or falling order.
+    fn lanes_of_round(round: usize) -> Vec<usize> {
+        let count = [PACKET, 5, 13, 20, 27, 1, 31][round % 7];
+        // (13 l + 7 round) mod 32 takes every value once over the lanes.
+        let mut lanes: Vec<usize> = (0..PACKET)
+            .filter(|l| (l * 13 + round * 7) % PACKET < count)
+            .collect();
+        if round % 2 == 1 {
+            lanes.reverse();
+        }
+        lanes
+    }
+
     /// Three uniform numbers in [-1, 1) drawn from `next`.
     fn r3(next: &mut impl FnMut() -> f32) -> Vec3A {
         Vec3A::new(next(), next(), next()) * 2.0 - 1.0
     }
 
-    /// Every lane's sample is `sample_lobes`'s for a Lambert material bit for bit, and its
+    /// Every lane's sample (of all lanes, or of some pushed in any order: `lanes_of_round`)
+    /// is `sample_lobes`'s for a Lambert material bit for bit, and its
     /// evaluation towards a light sample given to it (two lanes in three: a random direction
     /// or the lane's own sampled one) `eval_lobes`'s: shading normals bent away from the
     /// geometric one, both sides of the surface, normals next to -z (the frame's other
@@ -489,10 +552,10 @@ mod tests {
         assert!(m.is_lambert());
         let mut next = uniform(0x9e37_79b9);
         let mut checked = [0; 3];
-        for round in 0..64 {
+        for round in 0..128 {
             let mut lanes = DiffuseLanes::default();
             let mut cases = Vec::new();
-            for l in 0..PACKET {
+            for l in lanes_of_round(round) {
                 let ng = unit(r3(&mut next));
                 let mut ns = unit(r3(&mut next) * 0.3 + ng);
                 if l % 8 == 0 {
@@ -525,11 +588,14 @@ mod tests {
                     lanes.push_light(l, &ls);
                     (wi, eval_lobes(&m, color, &s, wo, wi))
                 });
-                cases.push((sample, light));
+                cases.push((l, sample, light));
             }
             lanes.compute();
             let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
-            for (l, (theirs, light)) in cases.iter().enumerate() {
+            let pushed = cases.iter().fold(0, |mask: Lanes, (l, ..)| mask | 1 << l);
+            assert_eq!(lanes.mask, pushed, "round {round}");
+            for (l, theirs, light) in &cases {
+                let l = *l;
                 let vertex = lanes.vertex(l);
                 let ours = lanes.given_light(l);
                 checked[2] += usize::from(assert_lit_as(ours, light.as_ref(), l, round));
@@ -581,10 +647,10 @@ mod tests {
         let m = LobesParams::decode(&[Vec4::ZERO; MODEL_PARAMS]);
         let mut next = uniform(0x1234_5679);
         let (mut lit, mut unlit) = (0, 0);
-        for _ in 0..64 {
+        for round in 0..128 {
             let mut lanes = DiffuseLanes::default();
             let mut cases = Vec::new();
-            for l in 0..PACKET {
+            for l in lanes_of_round(round) {
                 // Draw until the choice is the light wanted.
                 let (u_select, choice) = loop {
                     let u_select = next();
@@ -625,15 +691,18 @@ mod tests {
                 };
                 // What `Path::step` does with it.
                 let e = eval_lobes(&m, color, &s, wo, ls.wi);
-                cases.push((ls.valid && e.f.max_element() > 0.0).then(|| {
-                    let (ray, t_max) = shadow_ray(s.position, s.ng, &ls);
-                    let weight = power_heuristic(ls.pdf, e.pdf);
-                    let radiance = light_radiance(&cpu_scene, &params, &ls);
-                    (ray, t_max, throughput * e.f * radiance * weight / ls.pdf)
-                }));
+                cases.push((
+                    l,
+                    (ls.valid && e.f.max_element() > 0.0).then(|| {
+                        let (ray, t_max) = shadow_ray(s.position, s.ng, &ls);
+                        let weight = power_heuristic(ls.pdf, e.pdf);
+                        let radiance = light_radiance(&cpu_scene, &params, &ls);
+                        (ray, t_max, throughput * e.f * radiance * weight / ls.pdf)
+                    }),
+                ));
             }
             lanes.compute();
-            for (l, theirs) in cases.into_iter().enumerate() {
+            for (l, theirs) in cases {
                 let ours = lanes.vertex(l).shadow;
                 assert_eq!(ours.is_some(), theirs.is_some(), "lane {l}");
                 let (Some(ours), Some((ray, t_max, radiance))) = (ours, theirs) else {
