@@ -53,7 +53,7 @@ pub struct DiffuseVertex {
 /// Per lane, a diffuse vertex waiting for the rest of its bounce ([`DiffuseLanes::push`]),
 /// and after [`DiffuseLanes::compute`] its results ([`DiffuseLanes::vertex`]). The waiting
 /// lanes' values are packed in slots, in the order the lanes come, so that `compute` works
-/// on as many groups of [`GROUP`] slots as there are lanes waiting, not on the whole packet
+/// on as many groups of eight slots as there are lanes waiting, not on the whole packet
 /// (a packet with a third of its paths on diffuse surfaces costs half the work).
 #[derive(Debug, Clone)]
 pub struct DiffuseLanes {
@@ -268,7 +268,7 @@ impl DiffuseLanes {
         self.sky_light |= 1 << k;
     }
 
-    /// Computes the waiting lanes' slots side by side, in as many groups of [`GROUP`] as
+    /// Computes the waiting lanes' slots side by side, in as many groups of eight as
     /// they fill (the rest of the last group computes throw-away values).
     #[inline(always)]
     pub fn compute(&mut self) {

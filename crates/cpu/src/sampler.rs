@@ -463,7 +463,7 @@ const CAMERA_GROUPS: usize = 2 * PACKET / LANES;
 
 /// The camera's sample values (the film's point, then the lens's if there is one) of a
 /// packet's new samplers, gathered as they start ([`CameraPoints::start`]) and then drawn all
-/// at once ([`CameraPoints::draw`]): Sobol's [`LANES`] side by side, packed together, so that
+/// at once ([`CameraPoints::draw`]): Sobol's eight side by side, packed together, so that
 /// a packet's few new paths cost a few lanes' work, not a packet's, and no path waits on its
 /// own hash chain. Each sampler goes on past them, its first window (from dimension 0, the
 /// dimensions drawn here in it unused) still due, for [`Sampler::prepare_first`] once the path
