@@ -112,3 +112,63 @@ pub fn light_radiance(scene: &CpuScene, params: &GpuRenderParams, ls: &LightSamp
         None => ls.radiance,
     }
 }
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Over a fine grid of `u_select` (so frequencies are exact to about a grid step per
+    /// slot), in reference scenes of unequal lights (ten area-light entries; a sun, a point
+    /// and a spot light): the environment takes its share, each entry is chosen with its
+    /// probability (to 2e-5), and the part of `u_select` each entry passes on is uniform (its
+    /// mean and its fraction below 1/4 within 2e-3 of 1/2 and 1/4).
+    #[test]
+    fn lights_are_chosen_by_probability_with_a_uniform_rest() {
+        for name in ["cornell-materials", "lights"] {
+            let path = format!(
+                "{}/../../scenes/refs/{name}.toml",
+                env!("CARGO_MANIFEST_DIR")
+            );
+            let scene = pathlight_scene::load_scene_file(std::path::Path::new(&path)).unwrap();
+            let prepared = pathlight_core::PreparedScene::new(&scene).unwrap();
+            let cpu_scene = CpuScene::new(&prepared);
+            let mut params =
+                GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
+            params.env_pmf = 0.37;
+            let n = params.light_count as usize;
+            assert!(n >= 3, "{name}: {n} lights");
+            const STEPS: u32 = 1 << 20;
+            let (mut env, mut count) = (0u32, vec![0u32; n]);
+            let (mut part_sum, mut part_low) = (vec![0.0f64; n], vec![0u32; n]);
+            for k in 0..STEPS {
+                let u_select = (k as f32 + 0.5) / STEPS as f32;
+                let Some((light, pmf, u_part)) = choose_light(&cpu_scene, &params, u_select) else {
+                    env += 1;
+                    continue;
+                };
+                let entry = (0..n)
+                    .find(|&i| cpu_scene.lights.at(i as u32) == light)
+                    .unwrap();
+                assert_eq!(pmf, light.pmf * (1.0 - params.env_pmf), "{name}");
+                assert!((0.0..=1.0).contains(&u_part), "{name}: {u_part}");
+                count[entry] += 1;
+                part_sum[entry] += f64::from(u_part);
+                part_low[entry] += u32::from(u_part < 0.25);
+            }
+            let share = |c: u32| f64::from(c) / f64::from(STEPS);
+            assert!((share(env) - 0.37).abs() < 2e-5, "{name}: {}", share(env));
+            for i in 0..n {
+                let want = f64::from(cpu_scene.lights.at(i as u32).pmf) * 0.63;
+                assert!(
+                    (share(count[i]) - want).abs() < 2e-5,
+                    "{name} {i}: {count:?}"
+                );
+                if count[i] > 2000 {
+                    let mean = part_sum[i] / f64::from(count[i]);
+                    let low = f64::from(part_low[i]) / f64::from(count[i]);
+                    assert!((mean - 0.5).abs() < 2e-3, "{name} {i}: mean {mean}");
+                    assert!((low - 0.25).abs() < 2e-3, "{name} {i}: {low} below 1/4");
+                }
+            }
+        }
+    }
+}
