@@ -1,13 +1,13 @@
 //! The rest of a bounce for the lanes of a packet whose paths stand on a purely diffuse
 //! surface (the lobes model with its Lambert lobe alone), computed side by side: each lane's
 //! BSDF sample (frame, cosine-weighted direction, validity, weight) and, where its light
-//! sample is on a quad or of a constant sky, that sample with the BSDF towards it, its
-//! multiple-importance weight and shadow ray; where the sample was taken elsewhere (an
+//! sample is on a quad, of a constant sky, or of a point, spot or sun light without size,
+//! that sample with the BSDF towards it, its multiple-importance weight and shadow ray; where the sample was taken elsewhere (an
 //! environment map's), the BSDF towards it. Written as loops over the lanes that the
 //! compiler turns into SIMD instructions, they take the place of long chains of scalar
 //! square roots and divisions per path. The values are the one-path functions' bit for bit
-//! (`sample_lobes`, `sample_area_light`, `sample_environment`, `eval_lobes`,
-//! `power_heuristic`, `shadow_ray`): the same operations in the same order. Scalar helpers
+//! (`sample_lobes`, `sample_area_light`, `sample_environment`, `sample_point_light`,
+//! `sample_sun_light`, `eval_lobes`, `power_heuristic`, `shadow_ray`): the same operations in the same order. Scalar helpers
 //! are called as they are (`sin_cos_turns`, `power_heuristic`); those written on glam's
 //! `Vec3A` are written again on `[f32; 3]` (`Frame` and the dot product in `soa.rs`,
 //! `sample_cosine_hemisphere` here), as the packet code keeps its lanes in plain arrays, and
@@ -17,6 +17,7 @@
 use std::f32::consts::{FRAC_1_PI, PI};
 
 use glam::{Vec2, Vec3A};
+use pathlight_core::gpu_types::{GpuLight, LIGHT_SUN};
 
 use crate::cpu_scene::CpuScene;
 use crate::integrator::{ShadowTest, T_MAX};
@@ -35,8 +36,8 @@ const GROUP: usize = 8;
 #[derive(Debug, Clone, Copy)]
 pub struct DiffuseVertex {
     /// The shadow test of its light sample where the lanes took it
-    /// ([`DiffuseLanes::push_quad_light`], [`DiffuseLanes::push_sky_light`]), unless the BSDF
-    /// passes nothing of it on.
+    /// ([`DiffuseLanes::push_quad_light`], [`DiffuseLanes::push_sky_light`],
+    /// [`DiffuseLanes::push_punctual_light`]), unless the BSDF passes nothing of it on.
     pub shadow: Option<ShadowTest>,
     /// The BSDF sample.
     pub sample: BsdfSample,
@@ -80,11 +81,22 @@ pub struct DiffuseLanes {
     /// Bit `k` set: slot `k`'s light sample is on a quad light, and waits too
     /// ([`DiffuseLanes::push_quad_light`]).
     quad_light: Lanes,
-    /// The quad (corner, edges, unit normal, area), the probability of having chosen it, its
-    /// radiance, the dimensions of the point on it, and the path's throughput.
+    /// The quad (corner, edges, unit normal, area).
     quad: [Lanes3; 4],
     quad_area: [f32; PACKET],
-    quad_pmf: [f32; PACKET],
+    /// Bit `k` set: slot `k`'s light sample is of a point or spot light without a radius, or
+    /// of a sun without a disk ([`DiffuseLanes::push_punctual_light`]), and waits too.
+    punctual_light: Lanes,
+    /// Per slot of `punctual_light`: a sun (or else a point or spot light).
+    sun: [bool; PACKET],
+    /// The point or spot light's position (a sun's direction towards it), and the spot's
+    /// axis, cosine of its outer angle and falloff scale (`sample_point_light`'s block).
+    punctual: [Lanes3; 2],
+    spot: [[f32; PACKET]; 2],
+    /// The probability of having chosen the light (quad or punctual), its radiance (a point
+    /// light's intensity, a sun's irradiance), the dimensions of the point on it, and the
+    /// path's throughput.
+    light_pmf: [f32; PACKET],
     emission: Lanes3,
     u_light: [[f32; PACKET]; 2],
     throughput: Lanes3,
@@ -122,7 +134,11 @@ impl Default for DiffuseLanes {
             quad_light: 0,
             quad: [zero; 4],
             quad_area: [1.0; PACKET],
-            quad_pmf: [0.0; PACKET],
+            punctual_light: 0,
+            sun: [false; PACKET],
+            punctual: [zero; 2],
+            spot: [[0.0; PACKET]; 2],
+            light_pmf: [0.0; PACKET],
             emission: zero,
             u_light: [[0.0; PACKET]; 2],
             throughput: zero,
@@ -156,6 +172,7 @@ impl DiffuseLanes {
         self.count = 0;
         self.quad_light = 0;
         self.sky_light = 0;
+        self.punctual_light = 0;
         self.given.clear();
     }
 
@@ -235,7 +252,7 @@ impl DiffuseLanes {
         }
         set_lane(&mut self.quad[3], k, scene.quad_normal(object));
         self.quad_area[k] = scene.quad_area(object);
-        self.quad_pmf[k] = pmf;
+        self.light_pmf[k] = pmf;
         set_lane(
             &mut self.emission,
             k,
@@ -268,6 +285,45 @@ impl DiffuseLanes {
         self.sky_light |= 1 << k;
     }
 
+    /// Lane `l` (also [`DiffuseLanes::push`]ed) samples `light`, a point or spot light
+    /// without a radius or a sun without a disk ([`crate::lights::is_delta_light`]), chosen
+    /// with probability `pmf`, as `sample_point_light` or `sample_sun_light` would, for a
+    /// path of throughput `throughput`.
+    #[inline(always)]
+    pub fn push_punctual_light(
+        &mut self,
+        l: usize,
+        scene: &CpuScene,
+        light: &GpuLight,
+        pmf: f32,
+        throughput: Vec3A,
+    ) {
+        let k = self.take_slot(l);
+        let block = light.index as usize;
+        let b = &scene.param_blocks[block..block + 2];
+        set_lane(
+            &mut self.punctual[0],
+            k,
+            Vec3A::new(b[0][0], b[0][1], b[0][2]),
+        );
+        set_lane(&mut self.emission, k, Vec3A::new(b[1][0], b[1][1], b[1][2]));
+        let sun = light.kind == LIGHT_SUN;
+        if !sun {
+            let axis = scene.param_blocks[block + 2];
+            set_lane(
+                &mut self.punctual[1],
+                k,
+                Vec3A::new(axis[0], axis[1], axis[2]),
+            );
+            self.spot[0][k] = axis[3];
+            self.spot[1][k] = b[1][3];
+        }
+        self.sun[k] = sun;
+        self.light_pmf[k] = pmf;
+        set_lane(&mut self.throughput, k, throughput);
+        self.punctual_light |= 1 << k;
+    }
+
     /// Computes the waiting lanes' slots side by side, in as many groups of eight as
     /// they fill (the rest of the last group computes throw-away values).
     #[inline(always)]
@@ -283,14 +339,22 @@ impl DiffuseLanes {
     /// [`DiffuseLanes::compute`] of the first `N` slots, a count the loops know.
     #[inline(always)]
     fn compute_slots<const N: usize>(&mut self) {
-        // The quads' loop writes every slot; the sky's then its own slots only, where there
-        // are both.
+        // The quads' loop writes every slot; the sky's and the punctual lights' then their
+        // own slots only, where a kind before them wrote too.
         if self.quad_light != 0 {
             self.light_quads::<N>();
         }
         match (self.sky_light != 0, self.quad_light != 0) {
             (true, true) => self.light_skies::<true, N>(),
             (true, false) => self.light_skies::<false, N>(),
+            _ => {}
+        }
+        match (
+            self.punctual_light != 0,
+            self.quad_light | self.sky_light != 0,
+        ) {
+            (true, true) => self.light_punctuals::<true, N>(),
+            (true, false) => self.light_punctuals::<false, N>(),
             _ => {}
         }
         for l in 0..N {
@@ -346,10 +410,11 @@ impl DiffuseLanes {
             let distance = dot(to_light, to_light).sqrt();
             let wi = to_light.map(|v| v / distance);
             let cos_l = dot(normal, wi.map(|v| -v));
-            let pdf = self.quad_pmf[l] * density * distance * distance / cos_l;
+            let pdf = self.light_pmf[l] * density * distance * distance / cos_l;
             // (A NaN distance or cosine makes `pdf` NaN.)
             let sampled = distance > 0.0 && cos_l > 0.0 && pdf > 0.0 && pdf.is_finite();
-            let (lit, origin, unblocked) = self.next_event(l, wi, pdf, sampled, at(&self.emission));
+            let radiance = at(&self.emission);
+            let (lit, origin, unblocked) = self.next_event(l, wi, pdf, sampled, radiance, true);
             let to_light: [f32; 3] = std::array::from_fn(|i| q[i] - origin[i]);
             let distance = dot(to_light, to_light).sqrt();
             let dir = to_light.map(|v| v / distance);
@@ -374,9 +439,74 @@ impl DiffuseLanes {
                 self.emission[1][l],
                 self.emission[2][l],
             ];
-            let (lit, origin, unblocked) = self.next_event(l, wi, pdf, pdf > 0.0, radiance);
+            let (lit, origin, unblocked) = self.next_event(l, wi, pdf, pdf > 0.0, radiance, true);
             let mine = !MASKED || self.sky_light >> l & 1 != 0;
             self.set_shadow(l, mine, lit, origin, wi, T_MAX, unblocked);
+        }
+    }
+
+    /// The point, spot and sun lights' samples side by side: `sample_point_light` without
+    /// a radius (towards the point, the spot's falloff, the inverse square) or
+    /// `sample_sun_light` without a disk (along its direction), then what `Path::step` does
+    /// with it, as [`DiffuseLanes::light_quads`] but without a multiple-importance weight (no
+    /// ray hits such a light); `MASKED`: leaving the other slots' results as they are.
+    #[inline(always)]
+    fn light_punctuals<const MASKED: bool, const N: usize>(&mut self) {
+        for l in 0..N {
+            let at = |a: &Lanes3| [a[0][l], a[1][l], a[2][l]];
+            let (p, target, axis) = (
+                at(&self.position),
+                at(&self.punctual[0]),
+                at(&self.punctual[1]),
+            );
+            let intensity = at(&self.emission);
+            let sun = self.sun[l];
+            // `sample_point_light`. Channel by channel, not `array::from_fn` or `map`, whose
+            // closures may be left out of line.
+            let to_center = [target[0] - p[0], target[1] - p[1], target[2] - p[2]];
+            let d2 = dot(to_center, to_center);
+            let d = d2.sqrt();
+            let towards = [to_center[0] / d, to_center[1] / d, to_center[2] / d];
+            let away = [-towards[0], -towards[1], -towards[2]];
+            let t = (dot(away, axis) - self.spot[0][l]) * self.spot[1][l];
+            let t = t.clamp(0.0, 1.0);
+            let falloff = t * t;
+            let fraction = falloff / d2;
+            let point_radiance = [
+                intensity[0] * fraction,
+                intensity[1] * fraction,
+                intensity[2] * fraction,
+            ];
+            let pdf = self.light_pmf[l];
+            let point_valid = d2 > 0.0
+                && falloff > 0.0
+                && point_radiance[0].is_finite()
+                && point_radiance[1].is_finite()
+                && point_radiance[2].is_finite();
+            // `sample_sun_light`: the direction and irradiance as they are.
+            let wi = if sun { target } else { towards };
+            let radiance = if sun { intensity } else { point_radiance };
+            let sampled = (sun || point_valid) && pdf > 0.0 && pdf.is_finite();
+            let (lit, origin, unblocked) = self.next_event(l, wi, pdf, sampled, radiance, false);
+            // `shadow_ray`: to the point, stopping short of it, or along the sun's direction.
+            let to_light = [
+                target[0] - origin[0],
+                target[1] - origin[1],
+                target[2] - origin[2],
+            ];
+            let distance = dot(to_light, to_light).sqrt();
+            let dir = if sun {
+                wi
+            } else {
+                [
+                    to_light[0] / distance,
+                    to_light[1] / distance,
+                    to_light[2] / distance,
+                ]
+            };
+            let t_max = if sun { T_MAX } else { distance * (1.0 - 1e-4) };
+            let mine = !MASKED || self.punctual_light >> l & 1 != 0;
+            self.set_shadow(l, mine, lit, origin, dir, t_max, unblocked);
         }
     }
 
@@ -384,7 +514,7 @@ impl DiffuseLanes {
     /// `sampled` where valid): `eval_lobes` of the Lambert lobe towards it, then whether it
     /// lights the vertex, the shadow ray's origin (`shadow_ray`'s, on the side of `ng` the
     /// light is on, as a lit lane's is), and the radiance it adds unblocked for the light's
-    /// `radiance` (`power_heuristic` weighted).
+    /// `radiance` (`power_heuristic` weighted where `mis`).
     #[inline(always)]
     fn next_event(
         &self,
@@ -393,6 +523,7 @@ impl DiffuseLanes {
         pdf: f32,
         sampled: bool,
         radiance: [f32; 3],
+        mis: bool,
     ) -> (bool, [f32; 3], [f32; 3]) {
         let at = |a: &Lanes3| [a[0][l], a[1][l], a[2][l]];
         let (p, n, ng, wo) = (at(&self.position), at(&self.n), at(&self.ng), at(&self.wo));
@@ -408,7 +539,11 @@ impl DiffuseLanes {
         };
         let bsdf_pdf = if seen { FRAC_1_PI * cos_i } else { 0.0 };
         let lit = sampled && f[0].max(f[1]).max(f[2]) > 0.0;
-        let weight = power_heuristic(pdf, bsdf_pdf);
+        let weight = if mis {
+            power_heuristic(pdf, bsdf_pdf)
+        } else {
+            1.0
+        };
         let eps = 1e-4 * (1.0 + p[0].abs().max(p[1].abs()).max(p[2].abs()));
         let origin = [p[0] + ng[0] * eps, p[1] + ng[1] * eps, p[2] + ng[2] * eps];
         let unblocked = |i: usize| self.throughput[i][l] * f[i] * radiance[i] * weight / pdf;
@@ -457,8 +592,9 @@ impl DiffuseLanes {
         } else {
             INVALID
         };
-        let shadow =
-            ((self.quad_light | self.sky_light) >> l & 1 != 0 && self.lit[l]).then(|| ShadowTest {
+        let shadow = ((self.quad_light | self.sky_light | self.punctual_light) >> l & 1 != 0
+            && self.lit[l])
+            .then(|| ShadowTest {
                 ray: Ray::new(lane(&self.shadow_origin, l), lane(&self.shadow_dir, l)),
                 t_max: self.shadow_t_max[l],
                 radiance: lane(&self.unblocked, l),
@@ -485,7 +621,7 @@ impl DiffuseLanes {
 
 #[cfg(test)]
 mod tests {
-    use glam::{Vec2, Vec4};
+    use glam::{Vec2, Vec3, Vec4};
 
     use pathlight_core::gpu_types::{GpuRenderParams, KIND_QUAD, LIGHT_AREA};
 
@@ -494,7 +630,9 @@ mod tests {
     use crate::integrator::shadow_ray;
     use crate::light_lanes::tests::assert_lit_as;
     use crate::light_sample::INVALID as INVALID_LIGHT;
-    use crate::lights::{choose_light, light_radiance, sample_light, sample_table_light};
+    use crate::lights::{
+        choose_light, is_delta_light, light_radiance, sample_light, sample_table_light,
+    };
     use crate::lobes::{LobesParams, eval_lobes, sample_lobes};
     use crate::material::MODEL_PARAMS;
     use crate::surface::Surface;
@@ -615,30 +753,72 @@ mod tests {
         assert!(checked.iter().all(|&n| n > 200), "{checked:?}");
     }
 
-    /// Which lights [`light_lanes_as_path_step`] samples.
+    /// Which lights [`light_lanes_as_path_step`] samples (several: in one packet, each
+    /// kind's results staying in its lanes).
     #[derive(Clone, Copy, PartialEq)]
-    enum Light {
-        Quad,
-        Sky,
-        /// Quads and a constant sky in one packet: each kind's results stay in its lanes.
-        Both,
+    struct Wanted {
+        quad: bool,
+        sky: bool,
+        /// Point, spot and sun lights without size.
+        punctual: bool,
     }
 
-    /// Every lane's light sample of kind `kind` in the reference scene `name` gives
-    /// `Path::step`'s shadow test bit for bit (the light's sampling, `eval_lobes`,
-    /// `power_heuristic`, `shadow_ray`, the radiance it adds), from random points, normals
-    /// and views: lit lanes, and unlit ones (the light behind the surface, the surface seen
-    /// from behind).
-    fn light_lanes_as_path_step(name: &str, kind: Light) {
+    const NONE: Wanted = Wanted {
+        quad: false,
+        sky: false,
+        punctual: false,
+    };
+
+    /// A point light, a spot light and a sun without size, and a point light with a radius
+    /// and a sun with a disk (which the lanes leave to `Path::step`), above the Cornell box.
+    fn punctual_lights() -> Vec<pathlight_scene::Light> {
+        use pathlight_scene::{Cone, Light as SceneLight, LightKind};
+        let light = |intensity: f32, kind| SceneLight {
+            name: "l".into(),
+            intensity: Vec3::new(1.0, 0.8, 0.6) * intensity,
+            kind,
+        };
+        let point = |position: Vec3, radius: f32, cone| LightKind::Point {
+            position,
+            radius,
+            cone,
+        };
+        let sun = |angular_diameter_deg: f32| LightKind::Sun {
+            direction: Vec3::new(0.3, -1.0, -0.2),
+            angular_diameter_deg,
+        };
+        let cone = Cone {
+            axis: Vec3::new(0.2, -1.0, 0.1),
+            inner_deg: 20.0,
+            outer_deg: 40.0,
+        };
+        vec![
+            light(2.0, point(Vec3::new(0.3, 1.5, 0.2), 0.0, None)),
+            light(5.0, point(Vec3::new(-0.4, 1.7, 0.4), 0.0, Some(cone))),
+            light(1.0, sun(0.0)),
+            light(2.0, point(Vec3::new(0.5, 1.2, -0.3), 0.1, None)),
+            light(1.0, sun(2.0)),
+        ]
+    }
+
+    /// Every lane's light sample of the kinds `kind` in the reference scene `name` (with
+    /// [`punctual_lights`] added where `add_lights`) gives `Path::step`'s shadow test bit for
+    /// bit (the light's sampling, `eval_lobes`, `power_heuristic`, `shadow_ray`, the
+    /// radiance it adds), from random points, normals and views: lit lanes, and unlit ones
+    /// (the light behind the surface, the surface seen from behind).
+    fn light_lanes_as_path_step(name: &str, kind: Wanted, add_lights: bool) {
         let path = format!(
             "{}/../../scenes/refs/{name}.toml",
             env!("CARGO_MANIFEST_DIR")
         );
-        let scene = pathlight_scene::load_scene_file(std::path::Path::new(&path)).unwrap();
+        let mut scene = pathlight_scene::load_scene_file(std::path::Path::new(&path)).unwrap();
+        if add_lights {
+            scene.lights.extend(punctual_lights());
+        }
         let prepared = pathlight_core::PreparedScene::new(&scene).unwrap();
         let cpu_scene = CpuScene::new(&prepared);
         let mut params = GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
-        if kind != Light::Quad {
+        if kind.sky {
             // A share of the light samples other than 1, so that its arithmetic shows, and a
             // sky of some colour.
             params.env_pmf = 0.37;
@@ -655,13 +835,12 @@ mod tests {
                 let (u_select, choice) = loop {
                     let u_select = next();
                     let choice = choose_light(&cpu_scene, &params, u_select);
-                    let wanted = match (kind, choice) {
-                        (Light::Quad | Light::Both, Some((light, _, _))) => {
-                            light.kind == LIGHT_AREA
-                                && cpu_scene.objects[light.index as usize].kind == KIND_QUAD
+                    let wanted = match choice {
+                        Some((light, _, _)) if light.kind == LIGHT_AREA => {
+                            kind.quad && cpu_scene.objects[light.index as usize].kind == KIND_QUAD
                         }
-                        (Light::Sky | Light::Both, None) => u_select < params.env_pmf,
-                        _ => false,
+                        Some((light, _, _)) => kind.punctual && is_delta_light(&cpu_scene, &light),
+                        None => kind.sky && u_select < params.env_pmf,
                     };
                     if wanted {
                         break (u_select, choice);
@@ -680,7 +859,12 @@ mod tests {
                 lanes.push(l, s.position, n, ng * side, wo, color, u_light, 0.5);
                 let ls = match choice {
                     Some((light, pmf, _)) => {
-                        lanes.push_quad_light(l, &cpu_scene, light.index, pmf, u_light, throughput);
+                        if light.kind == LIGHT_AREA {
+                            let index = light.index;
+                            lanes.push_quad_light(l, &cpu_scene, index, pmf, u_light, throughput);
+                        } else {
+                            lanes.push_punctual_light(l, &cpu_scene, &light, pmf, throughput);
+                        }
                         sample_table_light(&cpu_scene, light, pmf, s.position, u_light, 0.5)
                     }
                     None => {
@@ -695,7 +879,11 @@ mod tests {
                     l,
                     (ls.valid && e.f.max_element() > 0.0).then(|| {
                         let (ray, t_max) = shadow_ray(s.position, s.ng, &ls);
-                        let weight = power_heuristic(ls.pdf, e.pdf);
+                        let weight = if ls.mis {
+                            power_heuristic(ls.pdf, e.pdf)
+                        } else {
+                            1.0
+                        };
                         let radiance = light_radiance(&cpu_scene, &params, &ls);
                         (ray, t_max, throughput * e.f * radiance * weight / ls.pdf)
                     }),
@@ -727,19 +915,48 @@ mod tests {
     /// On cornell-materials' ceiling light. Fails with any operation reordered.
     #[test]
     fn quad_lights_as_path_step_bit_for_bit() {
-        light_lanes_as_path_step("cornell-materials", Light::Quad);
+        let kind = Wanted { quad: true, ..NONE };
+        light_lanes_as_path_step("cornell-materials", kind, false);
     }
 
     /// Under the furnace's constant sky.
     #[test]
     fn sky_lights_as_path_step_bit_for_bit() {
-        light_lanes_as_path_step("furnace-0.8", Light::Sky);
+        let kind = Wanted { sky: true, ..NONE };
+        light_lanes_as_path_step("furnace-0.8", kind, false);
     }
 
     /// Both in one packet (the sky's results written only to its own lanes). Fails with
     /// them written to every lane.
     #[test]
     fn quad_and_sky_lights_as_path_step_bit_for_bit() {
-        light_lanes_as_path_step("cornell-materials", Light::Both);
+        let kind = Wanted {
+            quad: true,
+            sky: true,
+            ..NONE
+        };
+        light_lanes_as_path_step("cornell-materials", kind, false);
+    }
+
+    /// The sun, point light and hard-edged spot of the reference scene `lights`.
+    #[test]
+    fn punctual_lights_as_path_step_bit_for_bit() {
+        let kind = Wanted {
+            punctual: true,
+            ..NONE
+        };
+        light_lanes_as_path_step("lights", kind, false);
+    }
+
+    /// All three kinds in one packet, the spot's falloff smooth (the punctual lights'
+    /// results written only to their own lanes).
+    #[test]
+    fn every_kind_of_light_as_path_step_bit_for_bit() {
+        let kind = Wanted {
+            quad: true,
+            sky: true,
+            punctual: true,
+        };
+        light_lanes_as_path_step("cornell-materials", kind, true);
     }
 }

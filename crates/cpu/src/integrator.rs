@@ -17,7 +17,9 @@ use crate::glossy::GlossyLanes;
 use crate::intersect::Ray;
 use crate::light_lanes::LitVertex;
 use crate::light_sample::LightSample;
-use crate::lights::{choose_light, light_pdf, light_radiance, sample_light, sample_table_light};
+use crate::lights::{
+    choose_light, is_delta_light, light_pdf, light_radiance, sample_light, sample_table_light,
+};
 use crate::map_lanes::{MapEscapes, sample_env_maps};
 use crate::material::{
     eval_material, has_continuous_material_lobe, is_lambert, lobes_params, material_absorption,
@@ -267,8 +269,8 @@ impl Path {
     /// `sampler`: adds what the path sees there,
     /// samples a light (returning its shadow ray, for the caller to trace and
     /// [`Path::add_unblocked`]) and the BSDF (the next ray), or ends the path. On a purely
-    /// diffuse surface the rest of the bounce (the BSDF sample, and the light sample of a quad
-    /// or a constant sky) is left to `diffuse` as lane `lane`: once
+    /// diffuse surface the rest of the bounce (the BSDF sample, and the light sample of a quad,
+    /// a constant sky, or a point, spot or sun light without size) is left to `diffuse` as lane `lane`: once
     /// [`DiffuseLanes::compute`] ran, [`Path::leave_diffuse`] goes on. On rough glass or a
     /// rough mirror (with `MIRROR_LANES`) the BSDF sample is left to `glass` or `glossy`
     /// likewise, and [`Path::leave_sampled`] goes on. At all such vertices a light sample of
@@ -388,9 +390,12 @@ impl Path {
                     && light.kind == LIGHT_AREA
                     && scene.objects[light.index as usize].kind == KIND_QUAD
             });
+            let punctual = choice.filter(|(light, _, _)| lambert && is_delta_light(scene, light));
             let sky = lambert && u_light_select < params.env_pmf && !has_env_map(params);
             if let Some((light, pmf, _)) = quad {
                 diffuse.push_quad_light(lane, scene, light.index, pmf, u_light, self.throughput);
+            } else if let Some((light, pmf, _)) = punctual {
+                diffuse.push_punctual_light(lane, scene, &light, pmf, self.throughput);
             } else if sky {
                 let radiance = Vec3A::from(params.environment);
                 diffuse.push_sky_light(lane, radiance, params.env_pmf, u_light, self.throughput);

@@ -103,6 +103,15 @@ pub fn sample_table_light(
     }
 }
 
+/// Whether `light` is a point or spot light without a radius or a sun without a disk: a
+/// light of one direction from a point, whose sample needs no numbers (the first `vec4` of
+/// both kinds' blocks ends with the radius or the disk's `1 - cos`).
+#[inline(always)]
+pub fn is_delta_light(scene: &CpuScene, light: &GpuLight) -> bool {
+    matches!(light.kind, LIGHT_POINT | LIGHT_SUN)
+        && scene.param_blocks[light.index as usize][3] <= 0.0
+}
+
 /// The radiance `ls` brings: its own, or the environment map's at its cell (looked up now;
 /// WGSL `sample_environment` looks it up at once).
 #[inline(always)]
@@ -170,5 +179,44 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The lights of the reference scene `lights` (a sun, a point and a spot light, none
+    /// with a size) are delta lights; a sun with a disk, a point light with a radius and
+    /// area lights are not.
+    #[test]
+    fn delta_lights_are_those_without_size() {
+        use pathlight_scene::LightKind;
+
+        let path = format!(
+            "{}/../../scenes/refs/lights.toml",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let mut scene = pathlight_scene::load_scene_file(std::path::Path::new(&path)).unwrap();
+        let delta = |scene: &pathlight_scene::Scene| {
+            let prepared = pathlight_core::PreparedScene::new(scene).unwrap();
+            let cpu_scene = CpuScene::new(&prepared);
+            let n = prepared.shading.light_count;
+            (0..n)
+                .map(|i| is_delta_light(&cpu_scene, &cpu_scene.lights.at(i)))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(delta(&scene), [true; 3]);
+        for light in &mut scene.lights {
+            match &mut light.kind {
+                LightKind::Point { radius, .. } => *radius = 0.1,
+                LightKind::Sun {
+                    angular_diameter_deg,
+                    ..
+                } => *angular_diameter_deg = 0.5,
+            }
+        }
+        assert_eq!(delta(&scene), [false; 3]);
+        let path = format!(
+            "{}/../../scenes/refs/cornell-materials.toml",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let boxed = pathlight_scene::load_scene_file(std::path::Path::new(&path)).unwrap();
+        assert!(delta(&boxed).iter().all(|d| !d));
     }
 }
