@@ -112,7 +112,7 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
         let found = hits.found();
         // The first windows of the new paths that go on, from their pixels' seeds.
         if WIDE {
-            in_pairs_and_one(found & started, |a, b| match b {
+            in_pairs(found & started, |a, b| match b {
                 Some(b) => {
                     if let Ok([sampler_a, sampler_b]) = samplers.get_disjoint_mut([a, b]) {
                         Sampler::prepare_first_pair(sampler_a, sampler_b);
@@ -202,28 +202,18 @@ fn prepare_windows(samplers: &mut [Sampler; PACKET], going_on: Lanes) {
         due |= Lanes::from(samplers[l].window_due()) << l;
     }
     in_pairs(due, |a, b| {
-        if let Ok([sampler_a, sampler_b]) = samplers.get_disjoint_mut([a, b]) {
+        if let Some(b) = b
+            && let Ok([sampler_a, sampler_b]) = samplers.get_disjoint_mut([a, b])
+        {
             Sampler::prepare_pair(sampler_a, sampler_b);
         }
     });
 }
 
-/// Calls `pair` with the lanes of `lanes` two by two, lowest first (an odd one left out).
-#[inline(always)]
-fn in_pairs(mut lanes: Lanes, mut pair: impl FnMut(usize, usize)) {
-    while lanes.count_ones() >= 2 {
-        let a = lanes.trailing_zeros() as usize;
-        lanes &= lanes - 1;
-        let b = lanes.trailing_zeros() as usize;
-        lanes &= lanes - 1;
-        pair(a, b);
-    }
-}
-
 /// Calls `pair` with the lanes of `lanes` two by two, lowest first, and an odd one left
 /// alone (`None` beside it).
 #[inline(always)]
-fn in_pairs_and_one(mut lanes: Lanes, mut pair: impl FnMut(usize, Option<usize>)) {
+fn in_pairs(mut lanes: Lanes, mut pair: impl FnMut(usize, Option<usize>)) {
     while lanes != 0 {
         let a = lanes.trailing_zeros() as usize;
         lanes &= lanes - 1;
