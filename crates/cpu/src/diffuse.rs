@@ -2,12 +2,13 @@
 //! surface (the lobes model with its Lambert lobe alone), computed side by side: each lane's
 //! BSDF sample (frame, cosine-weighted direction, validity, weight) and, where its light
 //! sample is on a quad, of a constant sky, or of a point, spot or sun light without size,
-//! that sample with the BSDF towards it, its multiple-importance weight and shadow ray; where the sample was taken elsewhere (an
-//! environment map's), the BSDF towards it. Written as loops over the lanes that the
-//! compiler turns into SIMD instructions, they take the place of long chains of scalar
-//! square roots and divisions per path. The values are the one-path functions' bit for bit
-//! (`sample_lobes`, `sample_area_light`, `sample_environment`, `sample_point_light`,
-//! `sample_sun_light`, `eval_lobes`, `power_heuristic`, `shadow_ray`): the same operations in the same order. Scalar helpers
+//! that sample with the BSDF towards it, its multiple-importance weight and shadow ray;
+//! where the sample was taken elsewhere (an environment map's), the BSDF towards it.
+//! Written as loops over the lanes that the compiler turns into SIMD instructions, they take
+//! the place of long chains of scalar square roots and divisions per path. The values are
+//! the one-path functions' bit for bit (`sample_lobes`, `sample_area_light`,
+//! `sample_environment`, `sample_point_light`, `sample_sun_light`, `eval_lobes`,
+//! `power_heuristic`, `shadow_ray`): the same operations in the same order. Scalar helpers
 //! are called as they are (`sin_cos_turns`, `power_heuristic`); those written on glam's
 //! `Vec3A` are written again on `[f32; 3]` (`Frame` and the dot product in `soa.rs`,
 //! `sample_cosine_hemisphere` here), as the packet code keeps its lanes in plain arrays, and
@@ -755,7 +756,7 @@ mod tests {
 
     /// Which lights [`light_lanes_as_path_step`] samples (several: in one packet, each
     /// kind's results staying in its lanes).
-    #[derive(Clone, Copy, PartialEq)]
+    #[derive(Clone, Copy)]
     struct Wanted {
         quad: bool,
         sky: bool,

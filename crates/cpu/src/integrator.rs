@@ -266,12 +266,12 @@ impl Path {
     }
 
     /// Goes on from `hit`, the nearest hit of [`Path::ray`], drawing from the path's
-    /// `sampler`: adds what the path sees there,
-    /// samples a light (returning its shadow ray, for the caller to trace and
-    /// [`Path::add_unblocked`]) and the BSDF (the next ray), or ends the path. On a purely
-    /// diffuse surface the rest of the bounce (the BSDF sample, and the light sample of a quad,
-    /// a constant sky, or a point, spot or sun light without size) is left to `diffuse` as lane `lane`: once
-    /// [`DiffuseLanes::compute`] ran, [`Path::leave_diffuse`] goes on. On rough glass or a
+    /// `sampler`: adds what the path sees there, samples a light (returning its shadow ray,
+    /// for the caller to trace and [`Path::add_unblocked`]) and the BSDF (the next ray), or
+    /// ends the path. On a purely diffuse surface the rest of the bounce (the BSDF sample,
+    /// and the light sample of a quad, a constant sky, or a point, spot or sun light without
+    /// size) is left to `diffuse` as lane `lane`: once [`DiffuseLanes::compute`] ran,
+    /// [`Path::leave_diffuse`] goes on. On rough glass or a
     /// rough mirror (with `MIRROR_LANES`) the BSDF sample is left to `glass` or `glossy`
     /// likewise, and [`Path::leave_sampled`] goes on. At all such vertices a light sample of
     /// the environment map is left to `lanes` too: [`ShadingLanes::compute`] takes it and
