@@ -103,8 +103,8 @@ pub fn sample_table_light(
     }
 }
 
-/// Whether `light` is a point or spot light without a radius or a sun without a disk: a
-/// light of one direction from a point, whose sample needs no numbers (the first `vec4` of
+/// Whether `light` is a point or spot light without a radius or a sun without a disk: light
+/// from one point or along one direction, whose sample draws no numbers (the first `vec4` of
 /// both kinds' blocks ends with the radius or the disk's `1 - cos`).
 #[inline(always)]
 pub fn is_delta_light(scene: &CpuScene, light: &GpuLight) -> bool {
@@ -121,6 +121,7 @@ pub fn light_radiance(scene: &CpuScene, params: &GpuRenderParams, ls: &LightSamp
         None => ls.radiance,
     }
 }
+
 #[cfg(test)]
 mod tests {
     use super::*;
