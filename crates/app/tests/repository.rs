@@ -160,6 +160,57 @@ fn no_file_cites_documents_outside_the_repository() {
     );
 }
 
+/// A document's headings, each with its line number (lines inside code fences left out).
+fn headings(text: &str) -> Vec<(usize, &str)> {
+    let mut fenced = false;
+    let mut found = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        if line.starts_with("```") {
+            fenced = !fenced;
+        } else if !fenced && line.starts_with('#') {
+            found.push((n + 1, line));
+        }
+    }
+    found
+}
+
+#[test]
+fn no_document_repeats_a_heading() {
+    // A section pasted twice (once the whole of BENCHMARKS.md was) shows as a heading said
+    // twice in one document.
+    let root = repo();
+    let mut files = Vec::new();
+    text_files(&root, &mut files);
+    let mut repeated = Vec::new();
+    let mut checked = 0;
+    for file in files
+        .iter()
+        .filter(|f| f.extension() == Some("md".as_ref()))
+    {
+        let text = std::fs::read_to_string(file).unwrap();
+        let mut seen = std::collections::HashMap::new();
+        for (n, heading) in headings(&text) {
+            checked += 1;
+            if let Some(first) = seen.insert(heading, n) {
+                let shown = file.strip_prefix(&root).unwrap_or(file).display();
+                repeated.push(format!("{shown}:{n}: {heading} (also line {first})"));
+            }
+        }
+    }
+    assert!(checked > 100, "only {checked} headings found");
+    assert!(
+        repeated.is_empty(),
+        "headings said twice in one document:\n{}",
+        repeated.join("\n")
+    );
+}
+
+#[test]
+fn the_heading_reader_skips_code_fences() {
+    let text = "# Title\n```sh\n# a comment\n```\n## Part\n";
+    assert_eq!(headings(text), [(1, "# Title"), (5, "## Part")]);
+}
+
 #[test]
 fn the_citation_reader_finds_paths_and_skips_patterns() {
     let text = "see `crates/core/src/bvh.rs`, `shaders/X.wgsl`, `scenes/*.toml`, `a b/c`, \
