@@ -1,0 +1,118 @@
+#!/usr/bin/env bash
+# Two builds of pathlight's CPU backend against each other, on this machine, in one run: the
+# measure BENCHMARKS.md calls "par.". Each round renders a scene with both builds at once, one
+# thread each, pinned to CPUs 0 and 1 and swapped from round to round, so that both see the
+# same moment of a shared host (on these 2-core machines a build's rate moves by 10% or more
+# between runs, but two builds run side by side move together). Printed per scene: the median
+# of the per-round ratios NEW / BASE of the samples/s each `render` reports (above 1: NEW is
+# faster), then every round's ratio. A change of a few percent needs more than one profile
+# training of each side to be believed (BENCHMARKS.md, "A profile's training moves a scene by
+# 6%"): build both in the same tree, since the tree's path moves the layout too.
+#
+# `--count` adds the instructions each build runs for the render alone (valgrind's
+# cachegrind, one thread, 64x64: the count at 24 spp less the count at 8 spp, so that loading
+# and writing cancel; within 1.5% from run to run, and hardly moved by a training, but not a
+# measure of time). Valgrind runs the x86-64-v3 row renderer whatever the CPU has. Installs
+# valgrind (apt-get, as root or with sudo) where it is missing.
+#
+#   bash bench/ab-cpu.sh [--rounds N] [--spp N] [--res N] [--count] BASE NEW [SCENE...]
+#     BASE, NEW: pathlight binaries; SCENE: a name in scenes/refs or a path to a scene file
+#     defaults: 8 rounds, 128 spp, 256x256, every scene of scenes/refs (the furnace rings
+#     left out but furnace-0.8)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROUNDS=8 SPP=128 RES=256 COUNT=false ARGS=()
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --rounds) ROUNDS=$2; shift 2 ;;
+        --spp) SPP=$2; shift 2 ;;
+        --res) RES=$2; shift 2 ;;
+        --count) COUNT=true; shift ;;
+        -*) echo "unknown option: $1" >&2; exit 2 ;;
+        *) ARGS+=("$1"); shift ;;
+    esac
+done
+if [ ${#ARGS[@]} -lt 2 ]; then
+    echo "usage: bash bench/ab-cpu.sh [--rounds N] [--spp N] [--res N] [--count] BASE NEW [SCENE...]" >&2
+    exit 2
+fi
+BASE=${ARGS[0]} NEW=${ARGS[1]}
+for bin in "$BASE" "$NEW"; do
+    [ -x "$bin" ] || { echo "not an executable: $bin" >&2; exit 1; }
+done
+if [ "$(nproc)" -lt 2 ]; then
+    echo "needs two CPUs (this machine has $(nproc)): the builds run side by side" >&2
+    exit 1
+fi
+SCENES=()
+for name in "${ARGS[@]:2}"; do
+    if [ -f "$name" ]; then
+        SCENES+=("$name")
+    elif [ -f "scenes/refs/$name.toml" ]; then
+        SCENES+=("scenes/refs/$name.toml")
+    else
+        echo "no such scene: $name (neither a file nor scenes/refs/$name.toml)" >&2
+        exit 1
+    fi
+done
+if [ ${#SCENES[@]} -eq 0 ]; then
+    for f in scenes/refs/*.toml; do
+        name=$(basename "$f" .toml)
+        case "$name" in furnace-*) [ "$name" = furnace-0.8 ] || continue ;; esac
+        SCENES+=("$f")
+    done
+fi
+if $COUNT && ! command -v valgrind >/dev/null; then
+    sudo_if_needed() { if [ "$(id -u)" = 0 ]; then "$@"; else sudo "$@"; fi; }
+    sudo_if_needed apt-get update
+    sudo_if_needed apt-get install -y valgrind
+fi
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+
+# Renders scene $2 with binary $1 on CPU $3 into $4 (a log), in the background.
+render_on() {
+    RAYON_NUM_THREADS=1 taskset -c "$3" "$1" render "$2" --backend cpu --width "$RES" \
+        --height "$RES" --spp "$SPP" -o "$out/$(basename "$4" .log).exr" >"$4" 2>&1 &
+}
+# The M samples/s a render's log reports.
+rate() {
+    local r
+    r=$(sed -n 's/.*render [0-9.]* s (\([0-9.]*\) M samples\/s).*/\1/p' "$1")
+    [ -n "$r" ] || { echo "a render failed:" >&2; cat "$1" >&2; exit 1; }
+    echo "$r"
+}
+# Instructions (millions) binary $1 runs to render scene $2 at 64x64, 24 spp less 8 spp.
+instructions() {
+    local counts=()
+    for spp in 8 24; do
+        counts+=("$(RAYON_NUM_THREADS=1 valgrind --tool=cachegrind --cache-sim=no \
+            --cachegrind-out-file=/dev/null "$1" render "$2" --backend cpu --width 64 \
+            --height 64 --spp "$spp" -o "$out/count.exr" 2>&1 |
+            sed -n 's/.*I *refs: *\([0-9,]*\).*/\1/p' | tr -d ,)")
+    done
+    echo $(((counts[1] - counts[0]) / 1000000))
+}
+
+echo "$(date -u +%F), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(nproc) CPUs, load $(cut -d' ' -f1 /proc/loadavg)"
+echo "BASE $BASE, NEW $NEW: ${RES}x${RES}, $SPP spp, $ROUNDS rounds, both at once, one thread each"
+for scene in "${SCENES[@]}"; do
+    ratios=()
+    for round in $(seq "$ROUNDS"); do
+        cpu_base=$((round % 2)) cpu_new=$(((round + 1) % 2))
+        render_on "$BASE" "$scene" "$cpu_base" "$out/base.log"
+        render_on "$NEW" "$scene" "$cpu_new" "$out/new.log"
+        wait
+        ratios+=("$(awk -v b="$(rate "$out/base.log")" -v n="$(rate "$out/new.log")" \
+            'BEGIN { printf "%.3f", n / b }')")
+    done
+    median=$(printf '%s\n' "${ratios[@]}" | sort -g |
+        awk '{ v[NR] = $1 } END { print (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) }')
+    line="$(basename "$scene" .toml): NEW/BASE median $median, rounds ${ratios[*]}"
+    if $COUNT; then
+        base_count=$(instructions "$BASE" "$scene")
+        new_count=$(instructions "$NEW" "$scene")
+        line+="; instructions $base_count -> $new_count M"
+    fi
+    echo "$line"
+done
