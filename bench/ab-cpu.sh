@@ -4,10 +4,13 @@
 # thread each, pinned to CPUs 0 and 1 and swapped from round to round, so that both see the
 # same moment of a shared host (on these 2-core machines a build's rate moves by 10% or more
 # between runs, but two builds run side by side move together). Printed per scene: the median
-# of the per-round ratios NEW / BASE of the samples/s each `render` reports (above 1: NEW is
-# faster), then every round's ratio. A change of a few percent needs more than one profile
-# training of each side to be believed (BENCHMARKS.md, "A profile's training moves a scene by
-# 6%"): build both in the same tree, since the tree's path moves the layout too.
+# of the per-round ratios NEW / BASE of the samples/s (the inverse ratio of the render times
+# each `render` reports, to the millisecond; above 1: NEW is faster), then every round's ratio.
+# Run against itself, a build's medians came within 1-2% of 1 (8 rounds; BENCHMARKS.md); a
+# render under a second is noisier: give the furnace `--spp 512`. A change of a few percent
+# needs more than one profile training of each side to be believed (BENCHMARKS.md, "A
+# profile's training moves a scene by 6%"): build both in the same tree, since the tree's path
+# moves the layout too.
 #
 # `--count` adds the instructions each build runs for the render alone (valgrind's
 # cachegrind, one thread, 64x64: the count at 24 spp less the count at 8 spp, so that loading
@@ -75,12 +78,12 @@ render_on() {
     RAYON_NUM_THREADS=1 taskset -c "$3" "$1" render "$2" --backend cpu --width "$RES" \
         --height "$RES" --spp "$SPP" -o "$out/$(basename "$4" .log).exr" >"$4" 2>&1 &
 }
-# The M samples/s a render's log reports.
-rate() {
-    local r
-    r=$(sed -n 's/.*render [0-9.]* s (\([0-9.]*\) M samples\/s).*/\1/p' "$1")
-    [ -n "$r" ] || { echo "a render failed:" >&2; cat "$1" >&2; exit 1; }
-    echo "$r"
+# The render time (seconds) a render's log reports.
+seconds() {
+    local t
+    t=$(sed -n 's/.*render \([0-9.]*\) s (.*/\1/p' "$1")
+    [ -n "$t" ] || { echo "a render failed:" >&2; cat "$1" >&2; exit 1; }
+    echo "$t"
 }
 # Instructions (millions) binary $1 runs to render scene $2 at 64x64, 24 spp less 8 spp.
 instructions() {
@@ -103,8 +106,8 @@ for scene in "${SCENES[@]}"; do
         render_on "$BASE" "$scene" "$cpu_base" "$out/base.log"
         render_on "$NEW" "$scene" "$cpu_new" "$out/new.log"
         wait
-        ratios+=("$(awk -v b="$(rate "$out/base.log")" -v n="$(rate "$out/new.log")" \
-            'BEGIN { printf "%.3f", n / b }')")
+        ratios+=("$(awk -v b="$(seconds "$out/base.log")" -v n="$(seconds "$out/new.log")" \
+            'BEGIN { printf "%.3f", b / n }')")
     done
     median=$(printf '%s\n' "${ratios[@]}" | sort -g |
         awk '{ v[NR] = $1 } END { print (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) }')
