@@ -26,12 +26,9 @@ use crate::intersect::Ray;
 use crate::light_lanes::{LightLanes, LitVertex};
 use crate::light_sample::LightSample;
 use crate::microfacet::{BsdfSample, INVALID};
-use crate::packet::{Lanes, PACKET};
+use crate::packet::{GROUP, Lanes, PACKET};
 use crate::sampling::{power_heuristic, sin_cos_turns};
 use crate::soa::{Lanes3, dot, frame_around, lane, set_lane, to_world};
-
-/// Slots [`DiffuseLanes::compute`] computes at once: one AVX2 register of `f32`s.
-const GROUP: usize = 8;
 
 /// A diffuse vertex with its BSDF sample, and what the path needs to go on from it.
 #[derive(Debug, Clone, Copy)]

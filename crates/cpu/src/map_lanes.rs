@@ -17,12 +17,13 @@ use crate::environment::{
     prefetch_cell, to_map,
 };
 use crate::light_sample::LightSample;
-use crate::packet::{Lanes, PACKET};
+use crate::packet::{GROUP, Lanes, PACKET};
 use crate::table::Table;
 
 /// The map's light samples of the lanes in `lanes`, at `u[l]` for lane `l`, given to
-/// `take(l, sample)` in lane order. Every lane is computed (a lane outside `lanes` from
-/// whatever its `u` holds) and only those in `lanes` are given.
+/// `take(l, sample)` in lane order. The lanes' numbers are packed in slots first, so that
+/// the searches work on as many groups of [`GROUP`] slots as there are lanes (env-sun's
+/// packets hold 19 a pass on average), not on the whole packet.
 #[inline(always)]
 pub fn sample_env_maps(
     scene: &CpuScene,
@@ -31,70 +32,109 @@ pub fn sample_env_maps(
     u: &[Vec2; PACKET],
     mut take: impl FnMut(usize, LightSample),
 ) {
-    let (d, guides) = (scene.env_distribution, scene.env_guides);
-    if lanes == 0 {
-        return;
-    }
-    let w = params.env_width;
-    let rows = params.env_height - 1;
+    let mut slots = Slots::default();
     let mut u0 = [0.0f32; PACKET];
     let mut u1 = [0.0f32; PACKET];
-    for l in 0..PACKET {
-        (u0[l], u1[l]) = (u[l].x.min(MAX_U), u[l].y.min(MAX_U));
+    slots.pack(lanes, |l, k| {
+        (u0[k], u1[k]) = (u[l].x.min(MAX_U), u[l].y.min(MAX_U));
+    });
+    let mut s = SlotSamples::default();
+    match slots.count.div_ceil(GROUP) {
+        0 => return,
+        1 => s.compute::<GROUP>(scene, params, &u0, &u1),
+        2 => s.compute::<{ 2 * GROUP }>(scene, params, &u0, &u1),
+        3 => s.compute::<{ 3 * GROUP }>(scene, params, &u0, &u1),
+        _ => s.compute::<PACKET>(scene, params, &u0, &u1),
     }
-    let row = cdf_search_lanes(d, guides, rows, &[0; PACKET], &[0; PACKET], &u0);
-    let mut start = [0u32; PACKET];
-    let mut guide = [0u32; PACKET];
-    for l in 0..PACKET {
-        start[l] = rows + params.env_height + row[l] * w;
-        guide[l] = rows + 1 + row[l] * (w + 1);
-    }
-    let column = cdf_search_lanes(d, guides, w, &start, &guide, &u1);
-    // The samples per coordinate, as computed side by side.
-    let mut wi = [[0.0f32; PACKET]; 3];
-    let mut pdf = [0.0f32; PACKET];
-    let mut f = [[0.0f32; PACKET]; 2];
-    for l in 0..PACKET {
-        let s = map_sample(d, params, [u0[l], u1[l]], row[l], column[l]);
-        (wi[0][l], wi[1][l], wi[2][l]) = (s.wi[0], s.wi[1], s.wi[2]);
-        pdf[l] = s.pdf;
-        (f[0][l], f[1][l]) = (s.f[0], s.f[1]);
-    }
-    let mut left = lanes;
-    while left != 0 {
-        let l = left.trailing_zeros() as usize;
-        left &= left - 1;
-        prefetch_cell(scene, params, row[l], column[l]);
-        let cell = MapCell::new(column[l], row[l], [f[0][l], f[1][l]]);
-        let dir = Vec3A::new(wi[0][l], wi[1][l], wi[2][l]);
-        take(l, map_light_sample(params, dir, pdf[l], cell));
+    for k in 0..slots.count {
+        prefetch_cell(scene, params, s.row[k], s.column[k]);
+        let cell = MapCell::new(s.column[k], s.row[k], [s.f[0][k], s.f[1][k]]);
+        let dir = Vec3A::new(s.wi[0][k], s.wi[1][k], s.wi[2][k]);
+        take(slots.lane(k), map_light_sample(params, dir, s.pdf[k], cell));
     }
 }
 
-/// `environment::cdf_search` for each lane: the first entry of the `n`-entry CDF at
+/// Map samples per slot, as [`SlotSamples::compute`] computes them side by side: the cell's
+/// row and column, the direction, its density and the position in the cell.
+#[derive(Debug, Clone, Default)]
+struct SlotSamples {
+    row: [u32; PACKET],
+    column: [u32; PACKET],
+    wi: [[f32; PACKET]; 3],
+    pdf: [f32; PACKET],
+    f: [[f32; PACKET]; 2],
+}
+
+impl SlotSamples {
+    /// The samples of the first `N` slots, a count the loops know: slot `k` at (`u0[k]`,
+    /// `u1[k]`).
+    #[inline(always)]
+    fn compute<const N: usize>(
+        &mut self,
+        scene: &CpuScene,
+        params: &GpuRenderParams,
+        u0: &[f32; PACKET],
+        u1: &[f32; PACKET],
+    ) {
+        let (d, guides) = (scene.env_distribution, scene.env_guides);
+        let w = params.env_width;
+        let rows = params.env_height - 1;
+        let u0: [f32; N] = std::array::from_fn(|k| u0[k]);
+        let u1: [f32; N] = std::array::from_fn(|k| u1[k]);
+        let row = cdf_search_lanes(d, guides, rows, &[0; N], &[0; N], &u0);
+        let mut start = [0u32; N];
+        let mut guide = [0u32; N];
+        for k in 0..N {
+            start[k] = rows + params.env_height + row[k] * w;
+            guide[k] = rows + 1 + row[k] * (w + 1);
+        }
+        let column = cdf_search_lanes(d, guides, w, &start, &guide, &u1);
+        // Computed in locals, side by side, then stored.
+        let mut wi = [[0.0f32; N]; 3];
+        let mut pdf = [0.0f32; N];
+        let mut f = [[0.0f32; N]; 2];
+        for k in 0..N {
+            let s = map_sample(d, params, [u0[k], u1[k]], row[k], column[k]);
+            (wi[0][k], wi[1][k], wi[2][k]) = (s.wi[0], s.wi[1], s.wi[2]);
+            pdf[k] = s.pdf;
+            (f[0][k], f[1][k]) = (s.f[0], s.f[1]);
+        }
+        self.row[..N].copy_from_slice(&row);
+        self.column[..N].copy_from_slice(&column);
+        self.pdf[..N].copy_from_slice(&pdf);
+        for (to, from) in self.wi.iter_mut().zip(&wi) {
+            to[..N].copy_from_slice(from);
+        }
+        for (to, from) in self.f.iter_mut().zip(&f) {
+            to[..N].copy_from_slice(from);
+        }
+    }
+}
+
+/// `environment::cdf_search` for each of `N` lanes: the first entry of the `n`-entry CDF at
 /// `start[l]` of `d` exceeding `u[l]` (the last when none does), searched from its guide
 /// table at `guide[l]` of `guides` with `first_above`'s halving steps (the same entries, so
 /// the same result), each step taken for every lane at once until every lane's window is one
 /// entry.
 #[inline(always)]
-fn cdf_search_lanes(
+fn cdf_search_lanes<const N: usize>(
     d: Table<'_, f32>,
     guides: Table<'_, u16>,
     n: u32,
-    start: &[u32; PACKET],
-    guide: &[u32; PACKET],
-    u: &[f32; PACKET],
-) -> [u32; PACKET] {
-    let mut base = [0u32; PACKET];
-    let mut size = [0u32; PACKET];
-    for l in 0..PACKET {
+    start: &[u32; N],
+    guide: &[u32; N],
+    u: &[f32; N],
+) -> [u32; N] {
+    let mut base = [0u32; N];
+    let mut size = [0u32; N];
+    for l in 0..N {
         let k = guide[l] + guide_bucket(u[l], n);
         let (lo, hi) = (guides.at(k), guides.at(k + 1));
         (base[l], size[l]) = (u32::from(lo), u32::from(hi.saturating_sub(lo)) + 1);
     }
     loop {
         let mut wider = false;
-        for l in 0..PACKET {
+        for l in 0..N {
             let half = size[l] / 2;
             // (A lane whose window is one entry reads its entry and moves by 0.)
             let value = d.at(start[l] + base[l] + half.max(1) - 1);
@@ -108,13 +148,46 @@ fn cdf_search_lanes(
     }
 }
 
+/// The lanes a pass computes, packed in slots in lane order: slot `k` of the first `count`
+/// is lane `lanes[k]`.
+#[derive(Debug, Clone, Copy, Default)]
+struct Slots {
+    count: usize,
+    lanes: [u8; PACKET],
+}
+
+impl Slots {
+    /// Packs the lanes of `lanes` in lane order, calling `put(l, k)` as lane `l` takes slot
+    /// `k`.
+    #[inline(always)]
+    fn pack(&mut self, lanes: Lanes, mut put: impl FnMut(usize, usize)) {
+        let mut left = lanes;
+        while left != 0 {
+            let l = left.trailing_zeros() as usize;
+            left &= left - 1;
+            put(l, self.count);
+            self.lanes[self.count] = l as u8;
+            self.count += 1;
+        }
+    }
+
+    /// The lane in slot `k`.
+    #[inline(always)]
+    fn lane(&self, k: usize) -> usize {
+        usize::from(self.lanes[k])
+    }
+}
+
 /// What the map shows the rays of a packet that escape: per lane, the radiance seen and the
 /// density of sampling the direction from the map, the environment's choice included
 /// ([`crate::environment::env_escape`]'s values with `mis`).
 #[derive(Debug, Clone)]
 pub struct MapEscapes {
+    /// Per slot (the escaping lanes packed in lane order), the radiance and the density.
     radiance: [[f32; PACKET]; 3],
     pdf: [f32; PACKET],
+    /// Lane `l`'s slot.
+    slots: [u8; PACKET],
 }
 
 impl Default for MapEscapes {
@@ -122,13 +195,15 @@ impl Default for MapEscapes {
         Self {
             radiance: [[0.0; PACKET]; 3],
             pdf: [0.0; PACKET],
+            slots: [0; PACKET],
         }
     }
 }
 
 impl MapEscapes {
-    /// Computes every lane's escape along `dir(l)` when a lane of `lanes` escapes (the other
-    /// lanes' values are thrown away).
+    /// Computes the escapes of the lanes in `lanes` along `dir(l)`, side by side, in as
+    /// many groups of [`GROUP`] as they fill (env-sun's packets have 15 escaping a pass on
+    /// average).
     #[inline(always)]
     pub fn compute(
         &mut self,
@@ -137,38 +212,59 @@ impl MapEscapes {
         lanes: Lanes,
         dir: impl Fn(usize) -> [f32; 3],
     ) {
-        if lanes == 0 {
-            return;
-        }
         // The directions, everything the lanes read and what they write, in locals: the
         // compiler cannot tell that stores to `self` leave `scene` and `params` be, or that
         // `dir` reads nothing the lanes write, and computes one lane at a time unless it can.
         let mut dirs = [[0.0f32; PACKET]; 3];
-        for (l, [x, y, z]) in (0..PACKET).map(dir).enumerate() {
-            (dirs[0][l], dirs[1][l], dirs[2][l]) = (x, y, z);
+        let mut slots = Slots::default();
+        slots.pack(lanes, |l, k| {
+            [dirs[0][k], dirs[1][k], dirs[2][k]] = dir(l);
+            self.slots[l] = k as u8;
+        });
+        match slots.count.div_ceil(GROUP) {
+            0 => {}
+            1 => self.compute_slots::<GROUP>(scene, params, &dirs),
+            2 => self.compute_slots::<{ 2 * GROUP }>(scene, params, &dirs),
+            3 => self.compute_slots::<{ 3 * GROUP }>(scene, params, &dirs),
+            _ => self.compute_slots::<PACKET>(scene, params, &dirs),
         }
+    }
+
+    /// [`MapEscapes::compute`] of the first `N` slots, slot `k` along direction
+    /// (`dirs[0][k]`, `dirs[1][k]`, `dirs[2][k]`), a count the loop knows.
+    #[inline(always)]
+    fn compute_slots<const N: usize>(
+        &mut self,
+        scene: &CpuScene,
+        params: &GpuRenderParams,
+        dirs: &[[f32; PACKET]; 3],
+    ) {
         let params = *params;
         let (d, texels) = (scene.env_distribution, scene.env_texels);
-        let mut pdf = [0.0f32; PACKET];
-        let mut radiance = [[0.0f32; PACKET]; 3];
-        for l in 0..PACKET {
-            let dir = [dirs[0][l], dirs[1][l], dirs[2][l]];
+        let mut pdf = [0.0f32; N];
+        let mut radiance = [[0.0f32; N]; 3];
+        for k in 0..N {
+            let dir = [dirs[0][k], dirs[1][k], dirs[2][k]];
             let c = map_cell(&params, map_uv(to_map(&params, dir)));
-            pdf[l] = params.env_pmf * cell_pdf(d, &params, &c);
-            [radiance[0][l], radiance[1][l], radiance[2][l]] = cell_color(texels, &params, &c);
+            pdf[k] = params.env_pmf * cell_pdf(d, &params, &c);
+            [radiance[0][k], radiance[1][k], radiance[2][k]] = cell_color(texels, &params, &c);
         }
-        (self.pdf, self.radiance) = (pdf, radiance);
+        self.pdf[..N].copy_from_slice(&pdf);
+        for (to, from) in self.radiance.iter_mut().zip(&radiance) {
+            to[..N].copy_from_slice(from);
+        }
     }
 
     /// Lane `l`'s radiance and density, once [`MapEscapes::compute`] ran with it.
     #[inline(always)]
     pub fn get(&self, l: usize) -> (Vec3A, f32) {
+        let k = usize::from(self.slots[l]);
         let radiance = Vec3A::new(
-            self.radiance[0][l],
-            self.radiance[1][l],
-            self.radiance[2][l],
+            self.radiance[0][k],
+            self.radiance[1][k],
+            self.radiance[2][k],
         );
-        (radiance, self.pdf[l])
+        (radiance, self.pdf[k])
     }
 }
 
@@ -203,7 +299,7 @@ mod tests {
             let scene = CpuScene::new(&prepared);
             let mut next = uniform(0x85eb_ca6b ^ seed);
             let mut escapes = MapEscapes::default();
-            for _ in 0..200 {
+            for round in 0..200 {
                 let mut dirs = [Vec3A::ZERO; PACKET];
                 for d in &mut dirs {
                     let v = Vec3A::new(next(), next(), next()) * 2.0 - 1.0;
@@ -221,8 +317,9 @@ mod tests {
                     (seam + across).normalize(),
                     (seam - across).normalize(),
                 ]);
-                escapes.compute(&scene, &params, Lanes::MAX, |l| dirs[l].to_array());
-                for (l, dir) in dirs.iter().enumerate() {
+                let lanes = some_lanes(&mut next, round);
+                escapes.compute(&scene, &params, lanes, |l| dirs[l].to_array());
+                for (l, dir) in dirs.iter().enumerate().filter(|(l, _)| lanes >> l & 1 != 0) {
                     let (radiance, pdf) = escapes.get(l);
                     let (alone, alone_pdf) = env_escape(&scene, &params, Vec3A::Y, *dir, true);
                     assert_eq!(
@@ -233,6 +330,20 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Lanes for round `round`: every lane in every fifth, otherwise `round % 32 + 1` lanes
+    /// at random places, so that every count of slots (each group of eight full, part full
+    /// or empty) is computed.
+    fn some_lanes(next: &mut impl FnMut() -> f32, round: usize) -> Lanes {
+        if round.is_multiple_of(5) {
+            return Lanes::MAX;
+        }
+        let mut lanes: Lanes = 0;
+        while (lanes.count_ones() as usize) < round % PACKET + 1 {
+            lanes |= 1 << ((next() * PACKET as f32) as usize).min(PACKET - 1);
+        }
+        lanes
     }
 
     fn bits(v: Vec3A) -> [u32; 3] {
@@ -253,11 +364,7 @@ mod tests {
                 // The ends of [0, 1) too.
                 u[0] = Vec2::new(0.0, 1.0f32.next_down());
                 u[1] = Vec2::new(1.0f32.next_down(), 0.0);
-                let lanes = if round % 2 == 0 {
-                    Lanes::MAX
-                } else {
-                    (next() * Lanes::MAX as f32) as Lanes
-                };
+                let lanes = some_lanes(&mut next, round);
                 let mut given = 0;
                 sample_env_maps(&scene, &params, lanes, &u, |l, got| {
                     given |= 1 << l;
