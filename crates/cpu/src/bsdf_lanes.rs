@@ -14,13 +14,13 @@ use crate::light_lanes::{LightLanes, LitVertex};
 use crate::light_sample::LightSample;
 use crate::lobes::LobesParams;
 use crate::microfacet::{BsdfSample, INVALID};
-use crate::packet::{Lanes, PACKET};
+use crate::packet::{GROUP, Lanes, PACKET};
 use crate::soa::{Lanes3, at, lane, set_lane};
 
-/// Waiting lanes computed one by one rather than all 32 side by side: with four, env-sun,
+/// Waiting lanes computed one by one rather than side by side: with four, env-sun,
 /// cornell-materials and lights rendered 2-3% sooner than with none or eight (a packet on
 /// a room's walls holds a lane or two on a sphere).
-const ONE_BY_ONE: u32 = 4;
+const ONE_BY_ONE: usize = 4;
 
 /// One lane's vertex, as a kind's sample reads it.
 #[derive(Debug, Clone, Copy)]
@@ -89,12 +89,18 @@ pub struct SampledVertex {
 
 /// Per lane, a vertex on a material of kind `M` waiting for its BSDF sample
 /// ([`SampleLanes::push`]), and after [`SampleLanes::compute`] its results
-/// ([`SampleLanes::vertex`]).
+/// ([`SampleLanes::vertex`]). The waiting lanes' values are packed in slots, in the order
+/// the lanes come, so that `compute` works on as many groups of [`GROUP`] slots as there are
+/// lanes waiting, not on the whole packet.
 #[derive(Debug, Clone)]
 pub struct SampleLanes<M> {
     /// Bit `l` set: lane `l` waits (or, after `compute`, has its results).
     pub mask: Lanes,
-    // Inputs.
+    /// How many lanes wait: the slots in use.
+    count: usize,
+    /// Lane `l`'s slot, where it waits.
+    slots: [u8; PACKET],
+    // Inputs, per slot.
     position: Lanes3,
     /// The shading and geometric normals on the shape's front side.
     ns: Lanes3,
@@ -123,6 +129,8 @@ impl<M: Default> Default for SampleLanes<M> {
         let zero = [[0.0; PACKET]; 3];
         Self {
             mask: 0,
+            count: 0,
+            slots: [0; PACKET],
             position: zero,
             ns: zero,
             ng: zero,
@@ -147,14 +155,21 @@ impl<M: LaneBsdf> SampleLanes<M> {
     #[inline(always)]
     pub fn clear(&mut self) {
         self.mask = 0;
+        self.count = 0;
         self.lights.clear();
     }
 
-    /// Lane `l`, which waits or is about to ([`SampleLanes::push`]), has the valid light
-    /// sample `ls`: the BSDF is evaluated towards it too.
+    /// The slot of lane `l`, which waits.
+    #[inline(always)]
+    fn slot(&self, l: usize) -> usize {
+        usize::from(self.slots[l])
+    }
+
+    /// Lane `l`, which waits ([`SampleLanes::push`]), has the valid light sample `ls`: the
+    /// BSDF is evaluated towards it too.
     #[inline(always)]
     pub fn push_light(&mut self, l: usize, ls: &LightSample) {
-        self.lights.push(l, ls);
+        self.lights.push(self.slot(l), ls);
     }
 
     /// Lane `l` waits at `position`, on a material of parameters `params` and base colour
@@ -177,48 +192,59 @@ impl<M: LaneBsdf> SampleLanes<M> {
         params: LobesParams,
         (u_fresnel, u, u_rr): (f32, Vec2, f32),
     ) {
-        set_lane(&mut self.position, l, position);
-        set_lane(&mut self.ns, l, ns);
-        set_lane(&mut self.ng, l, ng);
-        set_lane(&mut self.wo, l, wo);
-        set_lane(&mut self.color, l, color);
-        self.model.set(l, &params);
-        self.u_fresnel[l] = u_fresnel;
-        self.u[0][l] = u.x;
-        self.u[1][l] = u.y;
-        self.u_rr[l] = u_rr;
+        let k = self.count;
+        self.slots[l] = k as u8;
+        self.count += 1;
         self.mask |= 1 << l;
+        set_lane(&mut self.position, k, position);
+        set_lane(&mut self.ns, k, ns);
+        set_lane(&mut self.ng, k, ng);
+        set_lane(&mut self.wo, k, wo);
+        set_lane(&mut self.color, k, color);
+        self.model.set(k, &params);
+        self.u_fresnel[k] = u_fresnel;
+        self.u[0][k] = u.x;
+        self.u[1][k] = u.y;
+        self.u_rr[k] = u_rr;
     }
 
     /// Computes the waiting lanes' samples and the evaluations towards their light samples:
-    /// up to `ONE_BY_ONE` lanes one after another, more every lane side by side (those not
-    /// waiting compute throw-away values; computing only theirs, gathered into as few
-    /// AVX-512 registers as they fill, was slower).
+    /// up to `ONE_BY_ONE` slots one after another, more side by side in as many groups of
+    /// [`GROUP`] as they fill (the rest of the last group computes throw-away values).
     #[inline(always)]
     pub fn compute(&mut self) {
-        if self.mask.count_ones() <= ONE_BY_ONE {
-            let mut left = self.mask;
-            while left != 0 {
-                let l = left.trailing_zeros() as usize;
-                left &= left - 1;
-                self.compute_lane(l);
-                if self.lights.mask >> l & 1 != 0 {
-                    self.compute_light(l);
+        if self.count <= ONE_BY_ONE {
+            for k in 0..self.count {
+                self.compute_lane(k);
+                if self.lights.mask >> k & 1 != 0 {
+                    self.compute_light(k);
                 }
             }
             return;
         }
-        for l in 0..PACKET {
-            self.compute_lane(l);
+        match self.count.div_ceil(GROUP) {
+            1 => self.compute_slots::<GROUP>(),
+            2 => self.compute_slots::<{ 2 * GROUP }>(),
+            3 => self.compute_slots::<{ 3 * GROUP }>(),
+            _ => self.compute_slots::<PACKET>(),
+        }
+    }
+
+    /// [`SampleLanes::compute`] side by side over the first `N` slots, a count the loops
+    /// know.
+    #[inline(always)]
+    fn compute_slots<const N: usize>(&mut self) {
+        for k in 0..N {
+            self.compute_lane(k);
         }
         if self.lights.mask != 0 {
-            for l in 0..PACKET {
-                self.compute_light(l);
+            for k in 0..N {
+                self.compute_light(k);
             }
         }
     }
 
-    /// Lane `l`'s vertex.
+    /// Slot `l`'s vertex.
     #[inline(always)]
     fn lane_vertex(&self, l: usize) -> LaneVertex {
         LaneVertex {
@@ -231,7 +257,7 @@ impl<M: LaneBsdf> SampleLanes<M> {
         }
     }
 
-    /// Computes the evaluation towards lane `l`'s light sample.
+    /// Computes the evaluation towards slot `l`'s light sample.
     #[inline(always)]
     fn compute_light(&mut self, l: usize) {
         let e = self
@@ -243,7 +269,7 @@ impl<M: LaneBsdf> SampleLanes<M> {
         self.lights.pdf[l] = e.pdf;
     }
 
-    /// Computes lane `l`'s sample.
+    /// Computes slot `l`'s sample.
     #[inline(always)]
     fn compute_lane(&mut self, l: usize) {
         let s = self.model.sample(l, &self.lane_vertex(l));
@@ -259,6 +285,7 @@ impl<M: LaneBsdf> SampleLanes<M> {
     /// Lane `l`'s results, once [`SampleLanes::compute`] ran.
     #[inline(always)]
     pub fn vertex(&self, l: usize) -> SampledVertex {
+        let l = self.slot(l);
         let sample = if self.valid[l] {
             BsdfSample {
                 wi: lane(&self.wi, l),
@@ -289,6 +316,7 @@ impl<M: LaneBsdf> SampleLanes<M> {
     /// BSDF's evaluation towards it, once [`SampleLanes::compute`] ran.
     #[inline(always)]
     pub fn light(&self, l: usize) -> Option<LitVertex<'_>> {
+        let l = self.slot(l);
         let (position, ng) = (lane(&self.position, l), lane(&self.ng, l));
         self.lights.lit(l, position, ng)
     }

@@ -272,13 +272,12 @@ impl Path {
     /// and the light sample of a quad, a constant sky, or a point, spot or sun light without
     /// size) is left to `diffuse` as lane `lane`: once [`DiffuseLanes::compute`] ran,
     /// [`Path::leave_diffuse`] goes on. On rough glass or a
-    /// rough mirror (with `MIRROR_LANES`) the BSDF sample is left to `glass` or `glossy`
-    /// likewise, and [`Path::leave_sampled`] goes on. At all such vertices a light sample of
+    /// rough mirror the BSDF sample is left to `glass` or `glossy` likewise, and [`Path::leave_sampled`] goes on. At all such vertices a light sample of
     /// the environment map is left to `lanes` too: [`ShadingLanes::compute`] takes it and
     /// the kind evaluates the BSDF towards it, then [`Path::map_light_test`] gives its
     /// shadow test.
     #[inline(always)]
-    pub fn step<const MIRROR_LANES: bool>(
+    pub fn step(
         &mut self,
         sampler: &mut Sampler,
         scene: &CpuScene,
@@ -378,9 +377,8 @@ impl Path {
         let sampled_lanes = if lambert {
             None
         } else {
-            lobes_params(material).filter(|m| {
-                u_lobe < 1.0 && (m.is_rough_glass() || MIRROR_LANES && m.is_rough_mirror())
-            })
+            lobes_params(material)
+                .filter(|m| u_lobe < 1.0 && (m.is_rough_glass() || m.is_rough_mirror()))
         };
         let mut shadow = None;
         if continuous {
@@ -595,7 +593,7 @@ pub fn trace_path(
         lanes.clear();
         let escaped = Lanes::from(hit.is_none());
         lanes.escape(scene, params, escaped, |_| path.ray.dir.to_array());
-        let mut shadow = path.step::<true>(&mut sampler, scene, params, hit, &mut lanes, 0);
+        let mut shadow = path.step(&mut sampler, scene, params, hit, &mut lanes, 0);
         lanes.compute(scene, params);
         if lanes.map_lights() != 0 {
             shadow = shadow.or(path.map_light_test(scene, params, &lanes, 0));

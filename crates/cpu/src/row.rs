@@ -70,9 +70,8 @@ impl std::iter::Sum for Tally {
 /// time, their rays traced together as packets; a path that ends hands its lane to the next
 /// sample. The whole path tracer is inlined here, so that each [`InstructionSet`] level
 /// compiles all of it. `WIDE`: the level has AVX-512's 32 registers of sixteen lanes, worth
-/// computing rough mirrors' BSDF samples side by side (with AVX2's eight lanes they cost
-/// cornell-materials 3-4%) and two paths' sampler windows at once (with AVX2's sixteen
-/// registers they cost the furnace 7%: spilled).
+/// computing two paths' sampler windows at once (with AVX2's sixteen registers they cost
+/// the furnace 7%: spilled).
 #[inline(always)]
 fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut RowTotals) -> Tally {
     let (scene, params) = (job.scene, job.params);
@@ -143,7 +142,7 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
             let l = left.trailing_zeros() as usize;
             left &= left - 1;
             let (sampler, hit) = (&mut samplers[l], hits.hit(l));
-            let shadow = paths[l].step::<WIDE>(sampler, scene, params, hit, &mut shading, l);
+            let shadow = paths[l].step(sampler, scene, params, hit, &mut shading, l);
             shadow_tests.add(l, shadow);
         }
         shading.compute(scene, params);
