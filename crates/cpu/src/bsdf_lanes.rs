@@ -14,7 +14,8 @@ use crate::light_lanes::{LightLanes, LitVertex};
 use crate::light_sample::LightSample;
 use crate::lobes::LobesParams;
 use crate::microfacet::{BsdfSample, INVALID};
-use crate::packet::{GROUP, Lanes, PACKET};
+use crate::packet::{Lanes, PACKET};
+use crate::slots::{Slots, in_groups};
 use crate::soa::{Lanes3, at, lane, set_lane};
 
 /// Waiting lanes computed one by one rather than side by side: with four, env-sun,
@@ -90,16 +91,12 @@ pub struct SampledVertex {
 /// Per lane, a vertex on a material of kind `M` waiting for its BSDF sample
 /// ([`SampleLanes::push`]), and after [`SampleLanes::compute`] its results
 /// ([`SampleLanes::vertex`]). The waiting lanes' values are packed in slots, in the order
-/// the lanes come, so that `compute` works on as many groups of [`GROUP`] slots as there are
+/// the lanes come, so that `compute` works on as many groups of [`GROUP`](crate::slots::GROUP) slots as there are
 /// lanes waiting, not on the whole packet.
 #[derive(Debug, Clone)]
 pub struct SampleLanes<M> {
-    /// Bit `l` set: lane `l` waits (or, after `compute`, has its results).
-    pub mask: Lanes,
-    /// How many lanes wait: the slots in use.
-    count: usize,
-    /// Lane `l`'s slot, where it waits.
-    slots: [u8; PACKET],
+    /// The lanes waiting (or, after `compute`, with their results), and each one's slot.
+    slots: Slots,
     // Inputs, per slot.
     position: Lanes3,
     /// The shading and geometric normals on the shape's front side.
@@ -128,9 +125,7 @@ impl<M: Default> Default for SampleLanes<M> {
     fn default() -> Self {
         let zero = [[0.0; PACKET]; 3];
         Self {
-            mask: 0,
-            count: 0,
-            slots: [0; PACKET],
+            slots: Slots::default(),
             position: zero,
             ns: zero,
             ng: zero,
@@ -154,22 +149,21 @@ impl<M: LaneBsdf> SampleLanes<M> {
     /// No lane waits.
     #[inline(always)]
     pub fn clear(&mut self) {
-        self.mask = 0;
-        self.count = 0;
+        self.slots.clear();
         self.lights.clear();
     }
 
-    /// The slot of lane `l`, which waits.
+    /// Bit `l` set: lane `l` waits (or, after `compute`, has its results).
     #[inline(always)]
-    fn slot(&self, l: usize) -> usize {
-        usize::from(self.slots[l])
+    pub fn mask(&self) -> Lanes {
+        self.slots.mask
     }
 
     /// Lane `l`, which waits ([`SampleLanes::push`]), has the valid light sample `ls`: the
     /// BSDF is evaluated towards it too.
     #[inline(always)]
     pub fn push_light(&mut self, l: usize, ls: &LightSample) {
-        self.lights.push(self.slot(l), ls);
+        self.lights.push(self.slots.slot(l), ls);
     }
 
     /// Lane `l` waits at `position`, on a material of parameters `params` and base colour
@@ -192,10 +186,7 @@ impl<M: LaneBsdf> SampleLanes<M> {
         params: LobesParams,
         (u_fresnel, u, u_rr): (f32, Vec2, f32),
     ) {
-        let k = self.count;
-        self.slots[l] = k as u8;
-        self.count += 1;
-        self.mask |= 1 << l;
+        let k = self.slots.take(l);
         set_lane(&mut self.position, k, position);
         set_lane(&mut self.ns, k, ns);
         set_lane(&mut self.ng, k, ng);
@@ -210,11 +201,12 @@ impl<M: LaneBsdf> SampleLanes<M> {
 
     /// Computes the waiting lanes' samples and the evaluations towards their light samples:
     /// up to `ONE_BY_ONE` slots one after another, more side by side in as many groups of
-    /// [`GROUP`] as they fill (the rest of the last group computes throw-away values).
+    /// [`GROUP`](crate::slots::GROUP) as they fill (the rest of the last group computes throw-away values).
     #[inline(always)]
     pub fn compute(&mut self) {
-        if self.count <= ONE_BY_ONE {
-            for k in 0..self.count {
+        let count = self.slots.count();
+        if count <= ONE_BY_ONE {
+            for k in 0..count {
                 self.compute_lane(k);
                 if self.lights.mask >> k & 1 != 0 {
                     self.compute_light(k);
@@ -222,12 +214,7 @@ impl<M: LaneBsdf> SampleLanes<M> {
             }
             return;
         }
-        match self.count.div_ceil(GROUP) {
-            1 => self.compute_slots::<GROUP>(),
-            2 => self.compute_slots::<{ 2 * GROUP }>(),
-            3 => self.compute_slots::<{ 3 * GROUP }>(),
-            _ => self.compute_slots::<PACKET>(),
-        }
+        in_groups!(count, N => self.compute_slots::<N>());
     }
 
     /// [`SampleLanes::compute`] side by side over the first `N` slots, a count the loops
@@ -285,7 +272,7 @@ impl<M: LaneBsdf> SampleLanes<M> {
     /// Lane `l`'s results, once [`SampleLanes::compute`] ran.
     #[inline(always)]
     pub fn vertex(&self, l: usize) -> SampledVertex {
-        let l = self.slot(l);
+        let l = self.slots.slot(l);
         let sample = if self.valid[l] {
             BsdfSample {
                 wi: lane(&self.wi, l),
@@ -316,7 +303,7 @@ impl<M: LaneBsdf> SampleLanes<M> {
     /// BSDF's evaluation towards it, once [`SampleLanes::compute`] ran.
     #[inline(always)]
     pub fn light(&self, l: usize) -> Option<LitVertex<'_>> {
-        let l = self.slot(l);
+        let l = self.slots.slot(l);
         let (position, ng) = (lane(&self.position, l), lane(&self.ng, l));
         self.lights.lit(l, position, ng)
     }
@@ -410,7 +397,7 @@ pub(crate) mod tests {
                 cases.push((m, sample, light));
             }
             lanes.compute();
-            assert_eq!(lanes.mask.count_ones() as usize, cases.len());
+            assert_eq!(lanes.mask().count_ones() as usize, cases.len());
             let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
             for (l, (m, theirs, light)) in cases.iter().enumerate() {
                 let vertex = lanes.vertex((l * 7 + round) % PACKET);

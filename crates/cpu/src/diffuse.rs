@@ -26,8 +26,9 @@ use crate::intersect::Ray;
 use crate::light_lanes::{LightLanes, LitVertex};
 use crate::light_sample::LightSample;
 use crate::microfacet::{BsdfSample, INVALID};
-use crate::packet::{GROUP, Lanes, PACKET};
+use crate::packet::{Lanes, PACKET};
 use crate::sampling::{power_heuristic, sin_cos_turns};
+use crate::slots::{Slots, in_groups};
 use crate::soa::{Lanes3, dot, frame_around, lane, set_lane, to_world};
 
 /// A diffuse vertex with its BSDF sample, and what the path needs to go on from it.
@@ -51,17 +52,14 @@ pub struct DiffuseVertex {
 
 /// Per lane, a diffuse vertex waiting for the rest of its bounce ([`DiffuseLanes::push`]),
 /// and after [`DiffuseLanes::compute`] its results ([`DiffuseLanes::vertex`]). The waiting
-/// lanes' values are packed in slots, in the order the lanes come, so that `compute` works
-/// on as many groups of eight slots as there are lanes waiting, not on the whole packet
-/// (a packet with a third of its paths on diffuse surfaces costs half the work).
+/// lanes' values are packed in [`Slots`], in the order the lanes come, so that `compute`
+/// works on as many groups of eight slots as there are lanes waiting, not on the whole
+/// packet (a packet with a third of its paths on diffuse surfaces costs half the work).
 #[derive(Debug, Clone)]
 pub struct DiffuseLanes {
-    /// Bit `l` set: lane `l` waits (or, after `compute`, has its results).
-    pub mask: Lanes,
-    /// Lanes waiting, and each waiting lane's slot: the index of its values below (and in
-    /// the bit masks below).
-    count: usize,
-    slots: [u8; PACKET],
+    /// The lanes waiting (or, after `compute`, with their results), and each one's slot:
+    /// the index of its values below (and in the bit masks below).
+    slots: Slots,
     // Inputs, per slot.
     position: Lanes3,
     /// The shading and geometric normals, on the side of `wo`.
@@ -117,9 +115,7 @@ impl Default for DiffuseLanes {
     fn default() -> Self {
         let zero = [[0.0; PACKET]; 3];
         Self {
-            mask: 0,
-            count: 0,
-            slots: [0; PACKET],
+            slots: Slots::default(),
             position: zero,
             n: zero,
             ng: zero,
@@ -166,36 +162,24 @@ impl DiffuseLanes {
     /// No lane waits.
     #[inline(always)]
     pub fn clear(&mut self) {
-        self.mask = 0;
-        self.count = 0;
+        self.slots.clear();
         self.quad_light = 0;
         self.sky_light = 0;
         self.punctual_light = 0;
         self.given.clear();
     }
 
-    /// Lane `l`'s slot, given it now if it has none: it waits from now on.
+    /// Bit `l` set: lane `l` waits (or, after `compute`, has its results).
     #[inline(always)]
-    fn take_slot(&mut self, l: usize) -> usize {
-        if self.mask >> l & 1 == 0 {
-            self.slots[l] = self.count as u8;
-            self.count += 1;
-            self.mask |= 1 << l;
-        }
-        self.slot(l)
-    }
-
-    /// The slot of lane `l`, which waits.
-    #[inline(always)]
-    fn slot(&self, l: usize) -> usize {
-        usize::from(self.slots[l])
+    pub fn mask(&self) -> Lanes {
+        self.slots.mask
     }
 
     /// Lane `l` (also [`DiffuseLanes::push`]ed) has the valid light sample `ls`, taken
     /// elsewhere: the BSDF is evaluated towards it.
     #[inline(always)]
     pub fn push_light(&mut self, l: usize, ls: &LightSample) {
-        let k = self.slot(l);
+        let k = self.slots.slot(l);
         self.given.push(k, ls);
     }
 
@@ -218,7 +202,7 @@ impl DiffuseLanes {
         u: Vec2,
         u_rr: f32,
     ) {
-        let k = self.take_slot(l);
+        let k = self.slots.slot_or_take(l);
         set_lane(&mut self.position, k, position);
         set_lane(&mut self.n, k, n);
         set_lane(&mut self.ng, k, ng);
@@ -242,7 +226,7 @@ impl DiffuseLanes {
         u_light: Vec2,
         throughput: Vec3A,
     ) {
-        let k = self.take_slot(l);
+        let k = self.slots.slot_or_take(l);
         let o = &scene.objects[object as usize];
         let corners = [o.a, o.b, o.c].map(|v| Vec3A::from_slice(&v));
         for (quad, v) in self.quad.iter_mut().zip(corners) {
@@ -274,7 +258,7 @@ impl DiffuseLanes {
         u_light: Vec2,
         throughput: Vec3A,
     ) {
-        let k = self.take_slot(l);
+        let k = self.slots.slot_or_take(l);
         set_lane(&mut self.emission, k, radiance);
         self.sky_pmf = pmf;
         self.u_light[0][k] = u_light.x;
@@ -296,7 +280,7 @@ impl DiffuseLanes {
         pmf: f32,
         throughput: Vec3A,
     ) {
-        let k = self.take_slot(l);
+        let k = self.slots.slot_or_take(l);
         let block = light.index as usize;
         let b = &scene.param_blocks[block..block + 2];
         set_lane(
@@ -326,12 +310,7 @@ impl DiffuseLanes {
     /// they fill (the rest of the last group computes throw-away values).
     #[inline(always)]
     pub fn compute(&mut self) {
-        match self.count.div_ceil(GROUP) {
-            0 | 1 => self.compute_slots::<GROUP>(),
-            2 => self.compute_slots::<{ 2 * GROUP }>(),
-            3 => self.compute_slots::<{ 3 * GROUP }>(),
-            _ => self.compute_slots::<PACKET>(),
-        }
+        in_groups!(self.slots.count(), N => self.compute_slots::<N>());
     }
 
     /// [`DiffuseLanes::compute`] of the first `N` slots, a count the loops know.
@@ -577,7 +556,7 @@ impl DiffuseLanes {
     /// Lane `l`'s results, once [`DiffuseLanes::compute`] ran.
     #[inline(always)]
     pub fn vertex(&self, l: usize) -> DiffuseVertex {
-        let l = self.slot(l);
+        let l = self.slots.slot(l);
         let sample = if self.valid[l] {
             BsdfSample {
                 wi: lane(&self.wi, l),
@@ -611,7 +590,7 @@ impl DiffuseLanes {
     /// one, and the BSDF's evaluation towards it, once [`DiffuseLanes::compute`] ran.
     #[inline(always)]
     pub fn given_light(&self, l: usize) -> Option<LitVertex<'_>> {
-        let l = self.slot(l);
+        let l = self.slots.slot(l);
         let (position, ng) = (lane(&self.position, l), lane(&self.ng, l));
         self.given.lit(l, position, ng)
     }
@@ -729,7 +708,7 @@ mod tests {
             lanes.compute();
             let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
             let pushed = cases.iter().fold(0, |mask: Lanes, (l, ..)| mask | 1 << l);
-            assert_eq!(lanes.mask, pushed, "round {round}");
+            assert_eq!(lanes.mask(), pushed, "round {round}");
             for (l, theirs, light) in &cases {
                 let l = *l;
                 let vertex = lanes.vertex(l);

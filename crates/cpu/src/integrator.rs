@@ -157,13 +157,13 @@ impl ShadingLanes {
     #[inline(always)]
     pub fn compute(&mut self, scene: &CpuScene, params: &GpuRenderParams) {
         self.sample_map_lights(scene, params);
-        if self.diffuse.mask != 0 {
+        if self.diffuse.mask() != 0 {
             self.diffuse.compute();
         }
-        if self.glass.mask != 0 {
+        if self.glass.mask() != 0 {
             self.glass.compute();
         }
-        if self.glossy.mask != 0 {
+        if self.glossy.mask() != 0 {
             self.glossy.compute();
         }
     }
@@ -178,9 +178,9 @@ impl ShadingLanes {
     /// BSDF's evaluation towards it, once [`ShadingLanes::compute`] ran.
     #[inline(always)]
     fn map_light(&self, l: usize) -> Option<LitVertex<'_>> {
-        if self.diffuse.mask >> l & 1 != 0 {
+        if self.diffuse.mask() >> l & 1 != 0 {
             self.diffuse.given_light(l)
-        } else if self.glass.mask >> l & 1 != 0 {
+        } else if self.glass.mask() >> l & 1 != 0 {
             self.glass.light(l)
         } else {
             self.glossy.light(l)
@@ -198,9 +198,9 @@ impl ShadingLanes {
             if !ls.valid {
                 return;
             }
-            if diffuse.mask >> l & 1 != 0 {
+            if diffuse.mask() >> l & 1 != 0 {
                 diffuse.push_light(l, &ls);
-            } else if glass.mask >> l & 1 != 0 {
+            } else if glass.mask() >> l & 1 != 0 {
                 glass.push_light(l, &ls);
             } else {
                 glossy.push_light(l, &ls);
@@ -598,13 +598,13 @@ pub fn trace_path(
         if lanes.map_lights() != 0 {
             shadow = shadow.or(path.map_light_test(scene, params, &lanes, 0));
         }
-        if lanes.diffuse.mask != 0 {
+        if lanes.diffuse.mask() != 0 {
             shadow = shadow.or(path.leave_diffuse(params, &lanes.diffuse, 0));
         }
-        if lanes.glass.mask != 0 {
+        if lanes.glass.mask() != 0 {
             path.leave_sampled(params, &lanes.glass, 0);
         }
-        if lanes.glossy.mask != 0 {
+        if lanes.glossy.mask() != 0 {
             path.leave_sampled(params, &lanes.glossy, 0);
         }
         if let Some(shadow) = shadow

@@ -31,6 +31,7 @@ mod row;
 pub mod sampler;
 pub mod sampling;
 pub mod sheen;
+pub mod slots;
 mod soa;
 pub mod sun_light;
 pub mod surface;

@@ -17,12 +17,13 @@ use crate::environment::{
     prefetch_cell, to_map,
 };
 use crate::light_sample::LightSample;
-use crate::packet::{GROUP, Lanes, PACKET};
+use crate::packet::{Lanes, PACKET};
+use crate::slots::{Slots, in_groups};
 use crate::table::Table;
 
 /// The map's light samples of the lanes in `lanes`, at `u[l]` for lane `l`, given to
 /// `take(l, sample)` in lane order. The lanes' numbers are packed in slots first, so that
-/// the searches work on as many groups of [`GROUP`] slots as there are lanes (env-sun's
+/// the searches work on as many groups of [`GROUP`](crate::slots::GROUP) slots as there are lanes (env-sun's
 /// packets hold 19 a pass on average), not on the whole packet.
 #[inline(always)]
 pub fn sample_env_maps(
@@ -32,21 +33,14 @@ pub fn sample_env_maps(
     u: &[Vec2; PACKET],
     mut take: impl FnMut(usize, LightSample),
 ) {
-    let mut slots = Slots::default();
     let mut u0 = [0.0f32; PACKET];
     let mut u1 = [0.0f32; PACKET];
-    slots.pack(lanes, |l, k| {
+    let slots = Slots::packed(lanes, |l, k| {
         (u0[k], u1[k]) = (u[l].x.min(MAX_U), u[l].y.min(MAX_U));
     });
     let mut s = SlotSamples::default();
-    match slots.count.div_ceil(GROUP) {
-        0 => return,
-        1 => s.compute::<GROUP>(scene, params, &u0, &u1),
-        2 => s.compute::<{ 2 * GROUP }>(scene, params, &u0, &u1),
-        3 => s.compute::<{ 3 * GROUP }>(scene, params, &u0, &u1),
-        _ => s.compute::<PACKET>(scene, params, &u0, &u1),
-    }
-    for k in 0..slots.count {
+    in_groups!(slots.count(), N => s.compute::<N>(scene, params, &u0, &u1));
+    for k in 0..slots.count() {
         prefetch_cell(scene, params, s.row[k], s.column[k]);
         let cell = MapCell::new(s.column[k], s.row[k], [s.f[0][k], s.f[1][k]]);
         let dir = Vec3A::new(s.wi[0][k], s.wi[1][k], s.wi[2][k]);
@@ -148,36 +142,6 @@ fn cdf_search_lanes<const N: usize>(
     }
 }
 
-/// The lanes a pass computes, packed in slots in lane order: slot `k` of the first `count`
-/// is lane `lanes[k]`.
-#[derive(Debug, Clone, Copy, Default)]
-struct Slots {
-    count: usize,
-    lanes: [u8; PACKET],
-}
-
-impl Slots {
-    /// Packs the lanes of `lanes` in lane order, calling `put(l, k)` as lane `l` takes slot
-    /// `k`.
-    #[inline(always)]
-    fn pack(&mut self, lanes: Lanes, mut put: impl FnMut(usize, usize)) {
-        let mut left = lanes;
-        while left != 0 {
-            let l = left.trailing_zeros() as usize;
-            left &= left - 1;
-            put(l, self.count);
-            self.lanes[self.count] = l as u8;
-            self.count += 1;
-        }
-    }
-
-    /// The lane in slot `k`.
-    #[inline(always)]
-    fn lane(&self, k: usize) -> usize {
-        usize::from(self.lanes[k])
-    }
-}
-
 /// What the map shows the rays of a packet that escape: per lane, the radiance seen and the
 /// density of sampling the direction from the map, the environment's choice included
 /// ([`crate::environment::env_escape`]'s values with `mis`).
@@ -186,8 +150,8 @@ pub struct MapEscapes {
     /// Per slot (the escaping lanes packed in lane order), the radiance and the density.
     radiance: [[f32; PACKET]; 3],
     pdf: [f32; PACKET],
-    /// Lane `l`'s slot.
-    slots: [u8; PACKET],
+    /// The escaping lanes' slots.
+    slots: Slots,
 }
 
 impl Default for MapEscapes {
@@ -195,14 +159,14 @@ impl Default for MapEscapes {
         Self {
             radiance: [[0.0; PACKET]; 3],
             pdf: [0.0; PACKET],
-            slots: [0; PACKET],
+            slots: Slots::default(),
         }
     }
 }
 
 impl MapEscapes {
     /// Computes the escapes of the lanes in `lanes` along `dir(l)`, side by side, in as
-    /// many groups of [`GROUP`] as they fill (env-sun's packets have 15 escaping a pass on
+    /// many groups of [`GROUP`](crate::slots::GROUP) as they fill (env-sun's packets have 15 escaping a pass on
     /// average).
     #[inline(always)]
     pub fn compute(
@@ -216,18 +180,10 @@ impl MapEscapes {
         // compiler cannot tell that stores to `self` leave `scene` and `params` be, or that
         // `dir` reads nothing the lanes write, and computes one lane at a time unless it can.
         let mut dirs = [[0.0f32; PACKET]; 3];
-        let mut slots = Slots::default();
-        slots.pack(lanes, |l, k| {
+        self.slots = Slots::packed(lanes, |l, k| {
             [dirs[0][k], dirs[1][k], dirs[2][k]] = dir(l);
-            self.slots[l] = k as u8;
         });
-        match slots.count.div_ceil(GROUP) {
-            0 => {}
-            1 => self.compute_slots::<GROUP>(scene, params, &dirs),
-            2 => self.compute_slots::<{ 2 * GROUP }>(scene, params, &dirs),
-            3 => self.compute_slots::<{ 3 * GROUP }>(scene, params, &dirs),
-            _ => self.compute_slots::<PACKET>(scene, params, &dirs),
-        }
+        in_groups!(self.slots.count(), N => self.compute_slots::<N>(scene, params, &dirs));
     }
 
     /// [`MapEscapes::compute`] of the first `N` slots, slot `k` along direction
@@ -258,7 +214,7 @@ impl MapEscapes {
     /// Lane `l`'s radiance and density, once [`MapEscapes::compute`] ran with it.
     #[inline(always)]
     pub fn get(&self, l: usize) -> (Vec3A, f32) {
-        let k = usize::from(self.slots[l]);
+        let k = self.slots.slot(l);
         let radiance = Vec3A::new(
             self.radiance[0][k],
             self.radiance[1][k],

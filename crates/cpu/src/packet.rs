@@ -35,9 +35,6 @@ const MIN_SHARED_RAYS: u32 = 5;
 
 /// A bit mask of a packet's lanes (bit `l` is lane `l`).
 pub type Lanes = u32;
-/// Lanes that the side-by-side shading passes (`DiffuseLanes`, the map's lanes) compute at
-/// once when they pack their lanes in slots: one AVX2 register of `f32`s.
-pub const GROUP: usize = 8;
 const _: () = assert!(PACKET <= Lanes::BITS as usize);
 
 /// Up to [`PACKET`] rays to trace together.

@@ -153,7 +153,7 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
             shadow_tests.add(l, paths[l].map_light_test(scene, params, &shading, l));
         }
         let diffuse = &shading.diffuse;
-        let mut left = diffuse.mask;
+        let mut left = diffuse.mask();
         while left != 0 {
             let l = left.trailing_zeros() as usize;
             left &= left - 1;
@@ -248,7 +248,7 @@ fn leave_sampled<M: LaneBsdf>(
     computed: &SampleLanes<M>,
     params: &GpuRenderParams,
 ) {
-    let mut left = computed.mask;
+    let mut left = computed.mask();
     while left != 0 {
         let l = left.trailing_zeros() as usize;
         left &= left - 1;
