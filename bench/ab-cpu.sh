@@ -12,31 +12,38 @@
 # profile's training moves a scene by 6%"): build both in the same tree, since the tree's path
 # moves the layout too.
 #
+# `--alone` renders the builds one after the other instead, each alone on CPU 0 (which goes first
+# alternates), and prints the ratios BASE / NEW of their fastest and of their median render
+# times: the fastest of many rounds is the render least disturbed by the host. On a busy
+# shared host (load 1.2-1.5, 2026-11-28) side by side gave 0.92 and then 1.10 for the same two
+# builds, where alone a build against itself came within 1% (15 rounds at 128x128).
+#
 # `--count` adds the instructions each build runs for the render alone (valgrind's
 # cachegrind, one thread, 64x64: the count at 24 spp less the count at 8 spp, so that loading
 # and writing cancel; within 1.5% from run to run, and hardly moved by a training, but not a
 # measure of time). Valgrind runs the x86-64-v3 row renderer whatever the CPU has. Installs
 # valgrind (apt-get, as root or with sudo) where it is missing.
 #
-#   bash bench/ab-cpu.sh [--rounds N] [--spp N] [--res N] [--count] BASE NEW [SCENE...]
+#   bash bench/ab-cpu.sh [--rounds N] [--spp N] [--res N] [--alone] [--count] BASE NEW [SCENE...]
 #     BASE, NEW: pathlight binaries; SCENE: a name in scenes/refs or a path to a scene file
 #     defaults: 8 rounds, 128 spp, 256x256, every scene of scenes/refs (the furnace rings
 #     left out but furnace-0.8)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-ROUNDS=8 SPP=128 RES=256 COUNT=false ARGS=()
+ROUNDS=8 SPP=128 RES=256 ALONE=false COUNT=false ARGS=()
 while [ $# -gt 0 ]; do
     case "$1" in
         --rounds) ROUNDS=$2; shift 2 ;;
         --spp) SPP=$2; shift 2 ;;
         --res) RES=$2; shift 2 ;;
+        --alone) ALONE=true; shift ;;
         --count) COUNT=true; shift ;;
         -*) echo "unknown option: $1" >&2; exit 2 ;;
         *) ARGS+=("$1"); shift ;;
     esac
 done
 if [ ${#ARGS[@]} -lt 2 ]; then
-    echo "usage: bash bench/ab-cpu.sh [--rounds N] [--spp N] [--res N] [--count] BASE NEW [SCENE...]" >&2
+    echo "usage: bash bench/ab-cpu.sh [--rounds N] [--spp N] [--res N] [--alone] [--count] BASE NEW [SCENE...]" >&2
     exit 2
 fi
 BASE=${ARGS[0]} NEW=${ARGS[1]}
@@ -98,10 +105,28 @@ instructions() {
 }
 
 echo "$(date -u +%F), $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), $(nproc) CPUs, load $(cut -d' ' -f1 /proc/loadavg)"
-echo "BASE $BASE, NEW $NEW: ${RES}x${RES}, $SPP spp, $ROUNDS rounds, both at once, one thread each"
+if $ALONE; then
+    echo "BASE $BASE, NEW $NEW: ${RES}x${RES}, $SPP spp, $ROUNDS rounds, each alone on CPU 0, one thread"
+else
+    echo "BASE $BASE, NEW $NEW: ${RES}x${RES}, $SPP spp, $ROUNDS rounds, both at once, one thread each"
+fi
+# The median of the numbers on standard input.
+median() {
+    sort -g | awk '{ v[NR] = $1 } END { print (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) }'
+}
 for scene in "${SCENES[@]}"; do
-    ratios=()
+    ratios=() base_times=() new_times=()
     for round in $(seq "$ROUNDS"); do
+        if $ALONE; then
+            for who in $(if [ $((round % 2)) = 1 ]; then echo base new; else echo new base; fi); do
+                if [ "$who" = base ]; then bin=$BASE; else bin=$NEW; fi
+                render_on "$bin" "$scene" 0 "$out/$who.log"
+                wait
+            done
+            base_times+=("$(seconds "$out/base.log")")
+            new_times+=("$(seconds "$out/new.log")")
+            continue
+        fi
         cpu_base=$((round % 2)) cpu_new=$(((round + 1) % 2))
         render_on "$BASE" "$scene" "$cpu_base" "$out/base.log"
         render_on "$NEW" "$scene" "$cpu_new" "$out/new.log"
@@ -109,9 +134,17 @@ for scene in "${SCENES[@]}"; do
         ratios+=("$(awk -v b="$(seconds "$out/base.log")" -v n="$(seconds "$out/new.log")" \
             'BEGIN { printf "%.3f", b / n }')")
     done
-    median=$(printf '%s\n' "${ratios[@]}" | sort -g |
-        awk '{ v[NR] = $1 } END { print (NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2) }')
-    line="$(basename "$scene" .toml): NEW/BASE median $median, rounds ${ratios[*]}"
+    if $ALONE; then
+        fastest() { printf '%s\n' "$@" | sort -g | head -1; }
+        base_min=$(fastest "${base_times[@]}") new_min=$(fastest "${new_times[@]}")
+        base_median=$(printf '%s\n' "${base_times[@]}" | median)
+        new_median=$(printf '%s\n' "${new_times[@]}" | median)
+        line="$(basename "$scene" .toml): NEW/BASE fastest $(awk -v b="$base_min" -v n="$new_min" \
+            'BEGIN { printf "%.3f", b / n }') ($base_min s, $new_min s), median $(awk \
+            -v b="$base_median" -v n="$new_median" 'BEGIN { printf "%.3f", b / n }') ($base_median s, $new_median s)"
+    else
+        line="$(basename "$scene" .toml): NEW/BASE median $(printf '%s\n' "${ratios[@]}" | median), rounds ${ratios[*]}"
+    fi
     if $COUNT; then
         base_count=$(instructions "$BASE" "$scene")
         new_count=$(instructions "$NEW" "$scene")
