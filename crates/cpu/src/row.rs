@@ -163,21 +163,34 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
         leave_sampled(paths, &shading.glossy, params);
         let unblocked = shadow_tests.unblocked;
         let blocked = tracer.occluded_packet(&shadows);
+        // Each lane's outcome as a bit first, then a loop over each outcome's lanes: a branch
+        // per lane on whether its path ended (at random) mispredicted half the time.
+        let mut left = shadows.active & !blocked;
+        while left != 0 {
+            let l = left.trailing_zeros() as usize;
+            left &= left - 1;
+            paths[l].add_unblocked(unblocked[l]);
+        }
+        let mut ended: Lanes = 0;
         let mut left = occupied;
         while left != 0 {
             let l = left.trailing_zeros() as usize;
             left &= left - 1;
-            let path = &mut paths[l];
-            if (shadows.active & !blocked) >> l & 1 != 0 {
-                path.add_unblocked(unblocked[l]);
-            }
-            if path.alive {
-                packet.rays[l] = path.ray;
-            } else {
-                tally = tally + finish(path, row, columns[l]);
-                occupied &= !(1 << l);
-            }
+            ended |= Lanes::from(!paths[l].alive) << l;
         }
+        let mut left = occupied & !ended;
+        while left != 0 {
+            let l = left.trailing_zeros() as usize;
+            left &= left - 1;
+            packet.rays[l] = paths[l].ray;
+        }
+        let mut left = ended;
+        while left != 0 {
+            let l = left.trailing_zeros() as usize;
+            left &= left - 1;
+            tally = tally + finish(&paths[l], row, columns[l]);
+        }
+        occupied &= !ended;
     }
 }
 
