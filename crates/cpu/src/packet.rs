@@ -198,11 +198,12 @@ impl PacketHits {
     /// The hit of ray `lane`, if it hit anything.
     #[inline(always)]
     pub fn hit(&self, lane: usize) -> Option<Hit> {
-        (self.object[lane] != u32::MAX).then(|| self.get(lane))
+        (self.object[lane] != u32::MAX).then(|| self.nearest(lane))
     }
 
+    /// The hit of ray `l`, which hit something.
     #[inline(always)]
-    fn get(&self, l: usize) -> Hit {
+    pub fn nearest(&self, l: usize) -> Hit {
         Hit {
             t: self.t[l],
             object: self.object[l],
@@ -557,7 +558,7 @@ impl PacketWalk<'_> {
                 any_hit: self.any_hit,
                 object: TOP_LEVEL,
             };
-            let mut hit = hits.get(lane);
+            let mut hit = hits.nearest(lane);
             stacks.single.clear();
             match what {
                 Alone::Subtree(node) => single.tree::<true>(stacks.single, node, &mut hit),

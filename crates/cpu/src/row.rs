@@ -137,12 +137,20 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
             packet: &mut shadows,
             unblocked: [Vec3A::ZERO; PACKET],
         };
-        let mut left = occupied;
+        // The lanes whose rays escaped, then those whose rays hit: in each loop every step
+        // takes the same way there (a branch per lane on it mispredicted where the two mix).
+        let mut left = occupied & !found;
         while left != 0 {
             let l = left.trailing_zeros() as usize;
             left &= left - 1;
-            let (sampler, hit) = (&mut samplers[l], hits.hit(l));
-            let shadow = paths[l].step(sampler, scene, params, hit, &mut shading, l);
+            paths[l].step(&mut samplers[l], scene, params, None, &mut shading, l);
+        }
+        let mut left = occupied & found;
+        while left != 0 {
+            let l = left.trailing_zeros() as usize;
+            left &= left - 1;
+            let (sampler, hit) = (&mut samplers[l], hits.nearest(l));
+            let shadow = paths[l].step(sampler, scene, params, Some(hit), &mut shading, l);
             shadow_tests.add(l, shadow);
         }
         shading.compute(scene, params);
