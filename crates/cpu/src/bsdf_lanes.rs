@@ -91,8 +91,8 @@ pub struct SampledVertex {
 /// Per lane, a vertex on a material of kind `M` waiting for its BSDF sample
 /// ([`SampleLanes::push`]), and after [`SampleLanes::compute`] its results
 /// ([`SampleLanes::vertex`]). The waiting lanes' values are packed in slots, in the order
-/// the lanes come, so that `compute` works on as many groups of [`GROUP`](crate::slots::GROUP) slots as there are
-/// lanes waiting, not on the whole packet.
+/// the lanes come, so that `compute` works on as many groups of
+/// [`GROUP`](crate::slots::GROUP) slots as there are lanes waiting, not on the whole packet.
 #[derive(Debug, Clone)]
 pub struct SampleLanes<M> {
     /// The lanes waiting (or, after `compute`, with their results), and each one's slot.
@@ -201,7 +201,8 @@ impl<M: LaneBsdf> SampleLanes<M> {
 
     /// Computes the waiting lanes' samples and the evaluations towards their light samples:
     /// up to `ONE_BY_ONE` slots one after another, more side by side in as many groups of
-    /// [`GROUP`](crate::slots::GROUP) as they fill (the rest of the last group computes throw-away values).
+    /// [`GROUP`](crate::slots::GROUP) as they fill (the rest of the last group computes
+    /// throw-away values).
     #[inline(always)]
     pub fn compute(&mut self) {
         let count = self.slots.count();

@@ -23,8 +23,8 @@ use crate::table::Table;
 
 /// The map's light samples of the lanes in `lanes`, at `u[l]` for lane `l`, given to
 /// `take(l, sample)` in lane order. The lanes' numbers are packed in slots first, so that
-/// the searches work on as many groups of [`GROUP`](crate::slots::GROUP) slots as there are lanes (env-sun's
-/// packets hold 19 a pass on average), not on the whole packet.
+/// the searches work on as many groups of [`GROUP`](crate::slots::GROUP) slots as there
+/// are lanes (env-sun's packets hold 19 a pass on average), not on the whole packet.
 #[inline(always)]
 pub fn sample_env_maps(
     scene: &CpuScene,
@@ -166,8 +166,8 @@ impl Default for MapEscapes {
 
 impl MapEscapes {
     /// Computes the escapes of the lanes in `lanes` along `dir(l)`, side by side, in as
-    /// many groups of [`GROUP`](crate::slots::GROUP) as they fill (env-sun's packets have 15 escaping a pass on
-    /// average).
+    /// many groups of [`GROUP`](crate::slots::GROUP) as they fill (env-sun's packets have 15
+    /// escaping a pass on average).
     #[inline(always)]
     pub fn compute(
         &mut self,

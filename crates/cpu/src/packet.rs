@@ -195,13 +195,7 @@ impl PacketHits {
         self.searching = active;
     }
 
-    /// The hit of ray `lane`, if it hit anything.
-    #[inline(always)]
-    pub fn hit(&self, lane: usize) -> Option<Hit> {
-        (self.object[lane] != u32::MAX).then(|| self.nearest(lane))
-    }
-
-    /// The hit of ray `l`, which hit something.
+    /// The hit of ray `l`, which hit something ([`PacketHits::found`] has its bit).
     #[inline(always)]
     pub fn nearest(&self, l: usize) -> Hit {
         Hit {
@@ -257,7 +251,7 @@ impl PacketHits {
 
     /// Lanes that have hit something.
     #[inline(always)]
-    pub(crate) fn found(&self) -> Lanes {
+    pub fn found(&self) -> Lanes {
         let mut found = 0;
         for l in 0..PACKET {
             found |= Lanes::from(self.object[l] != u32::MAX) << l;
@@ -692,7 +686,7 @@ mod tests {
                 let (packet, lane) = packet_of(r, t);
                 let mut hits = PacketHits::default();
                 tracer.borrow_mut().intersect_packet(&packet, &mut hits);
-                hits.hit(lane)
+                (hits.found() >> lane & 1 != 0).then(|| hits.nearest(lane))
             },
             &mut |r, t| {
                 let (packet, lane) = packet_of(r, t);
