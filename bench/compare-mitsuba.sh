@@ -11,7 +11,9 @@
 # pathlight reaches an error first (Monte Carlo error falls as 1/time). `--baseline BIN` adds
 # another pathlight binary (an older build) to each round, and its samples/s, ratio and
 # time-to-equal-error ratio to each line: two versions compared in one run, against the same
-# Mitsuba rounds.
+# Mitsuba rounds. With env-sun and env-sky both run, a last line gives what the environment
+# map costs each renderer per sample: env-sun's median time over that of env-sky, its
+# constant-sky twin.
 #
 # On a GPU machine, `--backend gpu --variant cuda_ad_rgb` compares pathlight's GPU backend
 # with Mitsuba's CUDA variant; both sides are then timed by render time alone (pathlight's as
@@ -106,6 +108,7 @@ header='%-26s %12s %12s %7s %10s %10s %8s'
 # shellcheck disable=SC2059
 printf "$header\n" scene "pathlight" "Mitsuba" ratio "relMSE pl" "relMSE mi" "to-error" \
     ${BASELINE:+baseline "ratio" "to-error"}
+declare -A pl_median mi_median
 for scene in "${SCENES[@]}"; do
     pl_times=() mi_times=() base_times=()
     for round in $(seq "$ROUNDS"); do
@@ -120,6 +123,7 @@ for scene in "${SCENES[@]}"; do
     echo "$scene: pathlight ${pl_times[*]} s,${BASELINE:+ baseline ${base_times[*]} s,} Mitsuba ${mi_times[*]} s" >&2
     pl=$(printf '%s\n' "${pl_times[@]}" | median)
     mi=$(printf '%s\n' "${mi_times[@]}" | median)
+    pl_median[$scene]=$pl mi_median[$scene]=$mi
     errors=$(relmse "$scene" "$out/pathlight.exr")
     read -r pl_err mi_err <<<"$errors"
     line=$(awk -v s="$scene" -v n="$samples" -v p="$pl" -v m="$mi" -v pe="$pl_err" -v me="$mi_err" 'BEGIN {
@@ -133,6 +137,11 @@ for scene in "${SCENES[@]}"; do
     fi
     echo "$line"
 done
+if [ -n "${pl_median[env-sun]:-}" ] && [ -n "${pl_median[env-sky]:-}" ]; then
+    awk -v p="${pl_median[env-sun]}" -v ps="${pl_median[env-sky]}" -v m="${mi_median[env-sun]}" \
+        -v ms="${mi_median[env-sky]}" 'BEGIN {
+        printf "the map'"'"'s cost: env-sun'"'"'s time over its constant-sky twin env-sky'"'"'s, pathlight %.2f, Mitsuba %.2f\n", p / ps, m / ms }'
+fi
 echo "(pathlight: whole process on the CPU backend, render alone on the GPU; Mitsuba: render alone)"
 echo "(pathlight and Mitsuba in M samples/s; ratio = pathlight / Mitsuba samples/s; to-error = Mitsuba's time to pathlight's at equal error)"
 [ -z "$BASELINE" ] || echo "(baseline: $BASELINE, timed as pathlight in the same rounds; its ratio and to-error against the same Mitsuba)"

@@ -22,9 +22,10 @@ use pathlight_scene::{Scene, load_scene_file};
 
 /// Mitsuba 3.9.1's own relMSE at 128x128, 64 spp, llvm_ad_rgb, mean over seeds 0-7, from
 /// `python tools/mitsuba_refs.py relmse NAME --res 128 --spp 64 --seeds 8`.
-const MITSUBA_RELMSE_128: [(&str, f64); 9] = [
+const MITSUBA_RELMSE_128: [(&str, f64); 10] = [
     ("lights", 0.016592),
     ("env-sun", 0.007424),
+    ("env-sky", 0.001656),
     ("cornell-dof", 0.043774),
     ("cornell-diffuse", 0.001777),
     ("cornell-spheres", 0.044131),
@@ -168,6 +169,11 @@ fn textured_sphere_matches_mitsuba() {
 #[test]
 fn env_sun_matches_mitsuba() {
     check_against_mitsuba("env-sun");
+}
+
+#[test]
+fn env_sky_matches_mitsuba() {
+    check_against_mitsuba("env-sky");
 }
 
 #[test]
