@@ -92,7 +92,7 @@ pub struct ShadowTest {
 /// The vertices of a packet's paths whose shading waits to be computed side by side, by
 /// kind of material: [`Path::step`] leaves them here, the caller computes them
 /// ([`ShadingLanes::compute`]), takes the shadow tests of their environment map light
-/// samples ([`Path::map_light_test`]) and goes on with [`Path::leave_diffuse`] and
+/// samples ([`Path::left_light_test`]) and goes on with [`Path::leave_diffuse`] and
 /// [`Path::leave_sampled`].
 #[derive(Debug, Clone)]
 pub struct ShadingLanes {
@@ -106,6 +106,9 @@ pub struct ShadingLanes {
     /// map at `map_u[l]`, its light sample still to be taken.
     map_lights: Lanes,
     map_u: [Vec2; PACKET],
+    /// Bit `l` set: lane `l` (a rough glass or mirror vertex) gave its kind a light sample
+    /// taken in its step, for the kind to evaluate the BSDF towards it.
+    given_lights: Lanes,
     /// What the environment map shows the lanes whose rays escaped, computed before their
     /// steps ([`ShadingLanes::escape`]).
     escapes: MapEscapes,
@@ -122,6 +125,7 @@ impl Default for ShadingLanes {
             glossy: GlossyLanes::default(),
             map_lights: 0,
             map_u: [Vec2::ZERO; PACKET],
+            given_lights: 0,
             escapes: MapEscapes::default(),
         }
     }
@@ -135,6 +139,7 @@ impl ShadingLanes {
         self.glass.clear();
         self.glossy.clear();
         self.map_lights = 0;
+        self.given_lights = 0;
     }
 
     /// With an environment map, computes what it shows the lanes in `escaped`, whose rays
@@ -168,16 +173,18 @@ impl ShadingLanes {
         }
     }
 
-    /// Bit `l` set: lane `l` left an environment map light sample here.
+    /// Bit `l` set: lane `l` left a light sample here for its kind to evaluate the BSDF
+    /// towards (an environment map's, or one its step took on rough glass or a rough
+    /// mirror).
     #[inline(always)]
-    pub fn map_lights(&self) -> Lanes {
-        self.map_lights
+    pub fn lights_left(&self) -> Lanes {
+        self.map_lights | self.given_lights
     }
 
-    /// Lane `l`'s environment map light sample, if it left a valid one here, with the
-    /// BSDF's evaluation towards it, once [`ShadingLanes::compute`] ran.
+    /// Lane `l`'s light sample left here, if it left a valid one, with the BSDF's evaluation
+    /// towards it, once [`ShadingLanes::compute`] ran.
     #[inline(always)]
-    fn map_light(&self, l: usize) -> Option<LitVertex<'_>> {
+    fn light_left(&self, l: usize) -> Option<LitVertex<'_>> {
         if self.diffuse.mask() >> l & 1 != 0 {
             self.diffuse.given_light(l)
         } else if self.glass.mask() >> l & 1 != 0 {
@@ -272,10 +279,11 @@ impl Path {
     /// and the light sample of a quad, a constant sky, or a point, spot or sun light without
     /// size) is left to `diffuse` as lane `lane`: once [`DiffuseLanes::compute`] ran,
     /// [`Path::leave_diffuse`] goes on. On rough glass or a
-    /// rough mirror the BSDF sample is left to `glass` or `glossy` likewise, and [`Path::leave_sampled`] goes on. At all such vertices a light sample of
-    /// the environment map is left to `lanes` too: [`ShadingLanes::compute`] takes it and
-    /// the kind evaluates the BSDF towards it, then [`Path::map_light_test`] gives its
-    /// shadow test.
+    /// rough mirror the BSDF sample is left to `glass` or `glossy` likewise, and
+    /// [`Path::leave_sampled`] goes on. At all such vertices a light sample of the
+    /// environment map is left to `lanes` too: [`ShadingLanes::compute`] takes it and the
+    /// kind evaluates the BSDF towards it, then [`Path::left_light_test`] gives its shadow
+    /// test; on rough glass or a rough mirror so does any other light sample, taken here.
     #[inline(always)]
     pub fn step(
         &mut self,
@@ -292,6 +300,7 @@ impl Path {
             glossy,
             map_lights,
             map_u,
+            given_lights,
             escapes,
         } = lanes;
         self.depth += 1;
@@ -381,6 +390,9 @@ impl Path {
                 .filter(|m| u_lobe < 1.0 && (m.is_rough_glass() || m.is_rough_mirror()))
         };
         let mut shadow = None;
+        // A light sample taken here for the rough glass or mirror lanes to evaluate the BSDF
+        // towards (side by side, not a chain of dependent square roots and divisions).
+        let mut given = None;
         if continuous {
             let choice = choose_light(scene, params, u_light_select);
             let quad = choice.filter(|(light, _, _)| {
@@ -411,7 +423,9 @@ impl Path {
                     }
                     None => sample_light(scene, params, s.position, n, u_light_select, u_light),
                 };
-                if ls.valid {
+                if ls.valid && sampled_lanes.is_some() {
+                    given = Some(ls);
+                } else if ls.valid {
                     let e = eval_material(material, &s, wo, ls.wi);
                     shadow = self.shadow_test(scene, params, s.position, s.ng, &ls, &e);
                 }
@@ -430,6 +444,14 @@ impl Path {
                 glass.push(lane, position, s.ns, ng, wo, color, m, u);
             } else {
                 glossy.push(lane, position, s.ns, ng, wo, color, m, u);
+            }
+            if let Some(ls) = given {
+                if m.is_rough_glass() {
+                    glass.push_light(lane, &ls);
+                } else {
+                    glossy.push_light(lane, &ls);
+                }
+                *given_lights |= 1 << lane;
             }
             return shadow;
         }
@@ -451,18 +473,19 @@ impl Path {
         self.bounce(params, &v.sample, v.position, v.ng, v.n, v.u_rr);
     }
 
-    /// The shadow test of the environment map light sample that lane `lane` of `lanes`
-    /// left there, once [`ShadingLanes::compute`] ran and before the path leaves the vertex
-    /// (it reads the throughput that reached the vertex), as [`Path::step`] returns its own.
+    /// The shadow test of the light sample that lane `lane` of `lanes` left there
+    /// ([`ShadingLanes::lights_left`]), once [`ShadingLanes::compute`] ran and before the path
+    /// leaves the vertex (it reads the throughput that reached the vertex), as
+    /// [`Path::step`] returns its own.
     #[inline(always)]
-    pub fn map_light_test(
+    pub fn left_light_test(
         &mut self,
         scene: &CpuScene,
         params: &GpuRenderParams,
         lanes: &ShadingLanes,
         lane: usize,
     ) -> Option<ShadowTest> {
-        let v = lanes.map_light(lane)?;
+        let v = lanes.light_left(lane)?;
         self.shadow_test(scene, params, v.position, v.ng, v.light, &v.eval)
     }
 
@@ -595,8 +618,8 @@ pub fn trace_path(
         lanes.escape(scene, params, escaped, |_| path.ray.dir.to_array());
         let mut shadow = path.step(&mut sampler, scene, params, hit, &mut lanes, 0);
         lanes.compute(scene, params);
-        if lanes.map_lights() != 0 {
-            shadow = shadow.or(path.map_light_test(scene, params, &lanes, 0));
+        if lanes.lights_left() != 0 {
+            shadow = shadow.or(path.left_light_test(scene, params, &lanes, 0));
         }
         if lanes.diffuse.mask() != 0 {
             shadow = shadow.or(path.leave_diffuse(params, &lanes.diffuse, 0));

@@ -155,11 +155,11 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
             shadow_tests.add(l, shadow);
         }
         shading.compute(scene, params);
-        let mut left = shading.map_lights();
+        let mut left = shading.lights_left();
         while left != 0 {
             let l = left.trailing_zeros() as usize;
             left &= left - 1;
-            shadow_tests.add(l, paths[l].map_light_test(scene, params, &shading, l));
+            shadow_tests.add(l, paths[l].left_light_test(scene, params, &shading, l));
         }
         let diffuse = &shading.diffuse;
         let mut left = diffuse.mask();
