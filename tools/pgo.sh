@@ -5,6 +5,8 @@
 # at every instruction-set level (the auxiliary images and the independent sampler once),
 # small, and merges the counts. Run it after changing the CPU backend and commit the profile
 # with the change: a function changed since the profile was made is compiled without one.
+# It builds no release binary: `cargo build --release` afterwards builds one with the new
+# profile (the one in target/release before it ran was built with the old).
 # Needs rustup's llvm-tools (`rustup component add llvm-tools`).
 #
 # On a CPU with x86-64-v3 but without x86-64-v4+gfni (AVX-512 and GFNI), that level's row
@@ -103,4 +105,4 @@ else
 fi
 rustc -vV | sed -n 's/^LLVM version: //p' > pgo/llvm-version
 echo "pgo/pathlight-cpu.profdata: $(du -h pgo/pathlight-cpu.profdata | cut -f1)," \
-    "LLVM $(cat pgo/llvm-version)"
+    "LLVM $(cat pgo/llvm-version); \`cargo build --release\` builds with it"

@@ -91,8 +91,8 @@ pub struct ShadowTest {
 
 /// The vertices of a packet's paths whose shading waits to be computed side by side, by
 /// kind of material: [`Path::step`] leaves them here, the caller computes them
-/// ([`ShadingLanes::compute`]), takes the shadow tests of their environment map light
-/// samples ([`Path::left_light_test`]) and goes on with [`Path::leave_diffuse`] and
+/// ([`ShadingLanes::compute`]), takes the shadow tests of the light samples left to them
+/// ([`Path::left_light_test`]) and goes on with [`Path::leave_diffuse`] and
 /// [`Path::leave_sampled`].
 #[derive(Debug, Clone)]
 pub struct ShadingLanes {
@@ -278,9 +278,8 @@ impl Path {
     /// ends the path. On a purely diffuse surface the rest of the bounce (the BSDF sample,
     /// and the light sample of a quad, a constant sky, or a point, spot or sun light without
     /// size) is left to `diffuse` as lane `lane`: once [`DiffuseLanes::compute`] ran,
-    /// [`Path::leave_diffuse`] goes on. On rough glass or a
-    /// rough mirror the BSDF sample is left to `glass` or `glossy` likewise, and
-    /// [`Path::leave_sampled`] goes on. At all such vertices a light sample of the
+    /// [`Path::leave_diffuse`] goes on. On rough glass or a rough mirror the BSDF sample is
+    /// left to `glass` or `glossy` likewise, and [`Path::leave_sampled`] goes on. At all such vertices a light sample of the
     /// environment map is left to `lanes` too: [`ShadingLanes::compute`] takes it and the
     /// kind evaluates the BSDF towards it, then [`Path::left_light_test`] gives its shadow
     /// test; on rough glass or a rough mirror so does any other light sample, taken here.
