@@ -25,10 +25,14 @@ use crate::intersect::{
     MISS, ROBUST_FAR, Ray, ShearedRay, intersect_cylinder, intersect_quad, intersect_sphere,
     intersect_triangle,
 };
+use crate::slots::GROUP;
 use crate::textures::alpha_stops;
 
 /// Rays per packet.
 pub const PACKET: usize = 32;
+
+/// The lanes of a group of [`GROUP`] (its bits shifted down to the lowest).
+const GROUP_LANES: Lanes = (1 << GROUP) - 1;
 
 /// Below this many rays entering a node, the packet's rays go on alone.
 const MIN_SHARED_RAYS: u32 = 5;
@@ -238,14 +242,21 @@ impl PacketHits {
         let blend_f = |new: f32, old: f32, take: bool| {
             f32::from_bits(blend(new.to_bits(), old.to_bits(), take))
         };
-        for l in 0..PACKET {
-            let (t, b1, b2) = shape.intersect(rays, l, self.t[l]);
-            let take = (lanes >> l) & 1 != 0 && t < self.t[l];
-            self.t[l] = blend_f(t, self.t[l], take);
-            self.b1[l] = blend_f(b1, self.b1[l], take);
-            self.b2[l] = blend_f(b2, self.b2[l], take);
-            self.object[l] = blend(object, self.object[l], take);
-            self.primitive[l] = blend(primitive, self.primitive[l], take);
+        // Only the groups of eight lanes with a ray in `lanes` (a leaf's rays are some 5-14
+        // of 32 on the reference scenes, in 2.8-3.2 of the four groups).
+        for group in 0..PACKET / GROUP {
+            if (lanes >> (group * GROUP)) & GROUP_LANES == 0 {
+                continue;
+            }
+            for l in group * GROUP..(group + 1) * GROUP {
+                let (t, b1, b2) = shape.intersect(rays, l, self.t[l]);
+                let take = (lanes >> l) & 1 != 0 && t < self.t[l];
+                self.t[l] = blend_f(t, self.t[l], take);
+                self.b1[l] = blend_f(b1, self.b1[l], take);
+                self.b2[l] = blend_f(b2, self.b2[l], take);
+                self.object[l] = blend(object, self.object[l], take);
+                self.primitive[l] = blend(primitive, self.primitive[l], take);
+            }
         }
     }
 
