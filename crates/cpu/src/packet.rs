@@ -1,6 +1,7 @@
 //! Ray queries for packets of up to [`PACKET`] rays: the CPU backend traces its paths side
 //! by side, and their rays walk the 4-wide BVH together, each child box and each shape
-//! tested for all of them at once. The per-ray arithmetic is written as loops over the
+//! tested for all of them at once (a shape for the groups of eight lanes that hold one of
+//! the rays entering its leaf). The per-ray arithmetic is written as loops over the
 //! lanes, which the compiler turns into SIMD instructions of the caller's instruction set
 //! (32 lanes: two AVX-512 registers, four AVX2 ones; 32 measured faster than 16 and 8).
 //! Where a packet has spread so that few of its rays still enter a node, each of those goes
