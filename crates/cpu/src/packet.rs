@@ -655,9 +655,11 @@ mod tests {
     }
 
     /// Each ray traced in a packet with others of `rays`, at a lane that depends on the ray,
-    /// gets brute force's answer. Every other packet holds the ray alone (it walks alone from
-    /// the root), the others most lanes; a bit beyond the packet's lanes is set too and must
-    /// be ignored. Brute force looks in `truth`: `scene` itself, or the same scene with its
+    /// gets brute force's answer. A third of the packets hold the ray alone (it walks alone
+    /// from the root), a third most lanes, a third the ray and the last lane of each group
+    /// of eight (enough to walk as a packet, each group's only ray in its top lane, for
+    /// the shape tests that skip the groups without one); a bit beyond the packet's lanes is
+    /// set too and must be ignored. Brute force looks in `truth`: `scene` itself, or the same scene with its
     /// instances flattened.
     fn assert_packets(scene: &CpuScene, truth: &CpuScene, rays: &[Ray]) -> usize {
         let tracer = RefCell::new(Tracer::new(scene));
@@ -665,10 +667,10 @@ mod tests {
             let start = ray.origin.x.to_bits() as usize % rays.len();
             let lane = start % PACKET;
             let beyond = Lanes::from(1u8).checked_shl(PACKET as u32).unwrap_or(0);
-            let others = if start.is_multiple_of(2) {
-                !0x0040_4040
-            } else {
-                0
+            let others = match start % 3 {
+                0 => !0x0040_4040,
+                1 => 0x8080_8080,
+                _ => 0,
             };
             let mut packet = RayPacket {
                 t_max: [t_max; PACKET],
