@@ -16,7 +16,7 @@ use crate::lobes::LobesParams;
 use crate::microfacet::{BsdfSample, INVALID};
 use crate::packet::{Lanes, PACKET};
 use crate::slots::{Slots, in_groups};
-use crate::soa::{Lanes3, at, lane, set_lane};
+use crate::soa::{Lanes3, at, dot, lane, set_lane};
 
 /// Waiting lanes computed one by one rather than side by side: with four, env-sun,
 /// cornell-materials and lights rendered 2-3% sooner than with none or eight (a packet on
@@ -166,6 +166,16 @@ impl<M: LaneBsdf> SampleLanes<M> {
         self.lights.push(self.slots.slot(l), ls);
     }
 
+    /// Lane `l`, which waits ([`SampleLanes::push`]), samples the constant sky of radiance
+    /// `radiance`, chosen with probability `pmf`, at `u_light`: [`SampleLanes::compute`]
+    /// takes that sample as `sample_environment` would (where it is valid, the BSDF is
+    /// evaluated towards it).
+    #[inline(always)]
+    pub fn push_sky_light(&mut self, l: usize, radiance: Vec3A, pmf: f32, u_light: Vec2) {
+        self.lights
+            .push_sky(self.slots.slot(l), radiance, pmf, u_light);
+    }
+
     /// Lane `l` waits at `position`, on a material of parameters `params` and base colour
     /// `color`, with shading normal `ns` and geometric normal `ng` (both on the shape's
     /// front side), seen from `wo`, with the dimensions (`u_fresnel`, `u`, `u_rr`) of its
@@ -209,6 +219,9 @@ impl<M: LaneBsdf> SampleLanes<M> {
         if count <= ONE_BY_ONE {
             for k in 0..count {
                 self.compute_lane(k);
+                if self.lights.sky >> k & 1 != 0 {
+                    self.lights.sample_sky(k, self.gathering_normal(k));
+                }
                 if self.lights.mask >> k & 1 != 0 {
                     self.compute_light(k);
                 }
@@ -225,11 +238,22 @@ impl<M: LaneBsdf> SampleLanes<M> {
         for k in 0..N {
             self.compute_lane(k);
         }
+        if self.lights.sky != 0 {
+            let (ns, ng, wo) = (&self.ns, &self.ng, &self.wo);
+            self.lights
+                .sample_skies::<N>(|k| gathering_normal(at(ns, k), at(ng, k), at(wo, k)));
+        }
         if self.lights.mask != 0 {
             for k in 0..N {
                 self.compute_light(k);
             }
         }
+    }
+
+    /// Slot `l`'s shading normal on the side of `wo`.
+    #[inline(always)]
+    fn gathering_normal(&self, l: usize) -> [f32; 3] {
+        gathering_normal(at(&self.ns, l), at(&self.ng, l), at(&self.wo, l))
     }
 
     /// Slot `l`'s vertex.
@@ -286,16 +310,11 @@ impl<M: LaneBsdf> SampleLanes<M> {
         } else {
             INVALID
         };
-        let (ns, ng) = (lane(&self.ns, l), lane(&self.ng, l));
         SampledVertex {
             sample,
             position: lane(&self.position, l),
-            ng,
-            n: if lane(&self.wo, l).dot(ng) >= 0.0 {
-                ns
-            } else {
-                -ns
-            },
+            ng: lane(&self.ng, l),
+            n: Vec3A::from_array(self.gathering_normal(l)),
             u_rr: self.u_rr[l],
         }
     }
@@ -310,13 +329,29 @@ impl<M: LaneBsdf> SampleLanes<M> {
     }
 }
 
+/// Shading normal `ns` (on the shape's front side, whose geometric normal is `ng`) on the
+/// side of `wo`, as `Path::step` turns it.
+#[inline(always)]
+fn gathering_normal(ns: [f32; 3], ng: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
+    if dot(wo, ng) >= 0.0 {
+        ns
+    } else {
+        ns.map(|c| -c)
+    }
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::cpu_scene::CpuScene;
+    use crate::environment::sample_environment;
     use crate::light_lanes::tests::assert_lit_as;
     use crate::light_sample::INVALID as INVALID_LIGHT;
     use crate::lobes::{eval_lobes, sample_lobes};
     use crate::surface::Surface;
+    use pathlight_core::PreparedScene;
+    use pathlight_core::gpu_types::GpuRenderParams;
+    use pathlight_scene::testing::scene_of;
 
     /// Uniform numbers in [0, 1) (xorshift from `state`).
     pub(crate) fn uniform(mut state: u32) -> impl FnMut() -> f32 {
@@ -335,7 +370,8 @@ pub(crate) mod tests {
 
     /// Checks that lanes of kind `M` compute `sample_lobes`'s samples bit for bit, and
     /// `eval_lobes`'s evaluations towards light samples (two lanes in three have one: a
-    /// random direction, or the lane's own sampled one), over 512 packets from one lane
+    /// random direction or the lane's own sampled one, or a constant sky's sample, which
+    /// the lanes take as `sample_environment` does), over 512 packets from one lane
     /// waiting to all, in any order: materials from `material` (given the lane and the
     /// random numbers), random geometric normals, shading normals bent away from them and
     /// next to -z (the frame's other branch), views from both sides, draws at 0 and next
@@ -348,6 +384,15 @@ pub(crate) mod tests {
     ) -> [usize; 4] {
         let mut next = uniform(seed);
         let mut outcomes = [0; 4];
+        let scene = scene_of(Vec::new());
+        let prepared = PreparedScene::new(&scene).unwrap();
+        let cpu_scene = CpuScene::new(&prepared);
+        let mut params = GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
+        // A share of the light samples other than 1, so that its arithmetic shows, and a sky
+        // of some colour.
+        params.env_pmf = 0.37;
+        params.environment = [0.3, 0.5, 0.7];
+        let sky = Vec3A::from(params.environment);
         for round in 0..512 {
             let mut lanes = SampleLanes::<M>::default();
             let mut cases = Vec::new();
@@ -380,29 +425,47 @@ pub(crate) mod tests {
                 let lane = (l * 7 + round) % PACKET;
                 lanes.push(lane, s.position, ns, ng, wo, color, m, (u_fresnel, u, 0.5));
                 let sample = sample_lobes(&m, color, &s, wo, 0.5, u_fresnel, u);
-                let light = (l % 3 != 1).then(|| {
-                    let wi = if l % 2 == 0 && sample.valid {
-                        sample.wi
-                    } else {
-                        unit(&mut next)
-                    };
-                    lanes.push_light(
-                        lane,
-                        &LightSample {
+                let mut sky_sample = None;
+                let light = match l % 3 {
+                    0 => {
+                        let wi = if l % 2 == 0 && sample.valid {
+                            sample.wi
+                        } else {
+                            unit(&mut next)
+                        };
+                        let ls = LightSample {
                             wi,
                             ..INVALID_LIGHT
-                        },
-                    );
-                    (wi, eval_lobes(&m, color, &s, wo, wi))
-                });
-                cases.push((m, sample, light));
+                        };
+                        lanes.push_light(lane, &ls);
+                        Some((wi, eval_lobes(&m, color, &s, wo, wi)))
+                    }
+                    2 => {
+                        let u_light = Vec2::new(next(), next());
+                        lanes.push_sky_light(lane, sky, params.env_pmf, u_light);
+                        let n = if wo.dot(ng) >= 0.0 { ns } else { -ns };
+                        let ls = sample_environment(&cpu_scene, &params, n, u_light);
+                        sky_sample = ls.valid.then_some(ls);
+                        ls.valid
+                            .then(|| (ls.wi, eval_lobes(&m, color, &s, wo, ls.wi)))
+                    }
+                    _ => None,
+                };
+                cases.push((m, sample, light, sky_sample));
             }
             lanes.compute();
             assert_eq!(lanes.mask().count_ones() as usize, cases.len());
             let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
-            for (l, (m, theirs, light)) in cases.iter().enumerate() {
+            for (l, (m, theirs, light, sky_sample)) in cases.iter().enumerate() {
                 let vertex = lanes.vertex((l * 7 + round) % PACKET);
                 let ours = lanes.light((l * 7 + round) % PACKET);
+                if let (Some(ours), Some(theirs)) = (&ours, sky_sample) {
+                    let ours = ours.light;
+                    assert_eq!(ours.pdf.to_bits(), theirs.pdf.to_bits(), "lane {l}");
+                    assert_eq!(ours.radiance, theirs.radiance, "lane {l}");
+                    assert_eq!((ours.mis, ours.finite), (theirs.mis, theirs.finite));
+                    assert!(ours.map_cell.is_none());
+                }
                 outcomes[3] += usize::from(assert_lit_as(ours, light.as_ref(), l, round));
                 let ours = vertex.sample;
                 assert_eq!(ours.valid, theirs.valid, "lane {l}, round {round}");

@@ -10,8 +10,8 @@
 //! `sample_environment`, `sample_point_light`, `sample_sun_light`, `eval_lobes`,
 //! `power_heuristic`, `shadow_ray`): the same operations in the same order. Scalar helpers
 //! are called as they are (`sin_cos_turns`, `power_heuristic`); those written on glam's
-//! `Vec3A` are written again on `[f32; 3]` (`Frame` and the dot product in `soa.rs`,
-//! `sample_cosine_hemisphere` here), as the packet code keeps its lanes in plain arrays, and
+//! `Vec3A` are written again on `[f32; 3]` (`Frame`, the dot product and
+//! `sample_cosine_hemisphere` in `soa.rs`), as the packet code keeps its lanes in plain arrays, and
 //! the tests hold each copy to its original. CPU only (on the GPU, threads are lanes
 //! already).
 
@@ -27,9 +27,9 @@ use crate::light_lanes::{LightLanes, LitVertex};
 use crate::light_sample::LightSample;
 use crate::microfacet::{BsdfSample, INVALID};
 use crate::packet::{Lanes, PACKET};
-use crate::sampling::{power_heuristic, sin_cos_turns};
+use crate::sampling::power_heuristic;
 use crate::slots::{Slots, in_groups};
-use crate::soa::{Lanes3, dot, frame_around, lane, set_lane, to_world};
+use crate::soa::{Lanes3, cosine_hemisphere, dot, frame_around, lane, set_lane, to_world};
 
 /// A diffuse vertex with its BSDF sample, and what the path needs to go on from it.
 #[derive(Debug, Clone, Copy)]
@@ -148,14 +148,6 @@ impl Default for DiffuseLanes {
             valid: [false; PACKET],
         }
     }
-}
-
-/// `sample_cosine_hemisphere([ux, uy])`.
-#[inline(always)]
-fn cosine_hemisphere(ux: f32, uy: f32) -> [f32; 3] {
-    let r = ux.sqrt();
-    let (sin, cos) = sin_cos_turns(uy);
-    [r * cos, r * sin, (1.0 - ux).max(0.0).sqrt()]
 }
 
 impl DiffuseLanes {

@@ -282,7 +282,8 @@ impl Path {
     /// left to `glass` or `glossy` likewise, and [`Path::leave_sampled`] goes on. At all such vertices a light sample of the
     /// environment map is left to `lanes` too: [`ShadingLanes::compute`] takes it and the
     /// kind evaluates the BSDF towards it, then [`Path::left_light_test`] gives its shadow
-    /// test; on rough glass or a rough mirror so does any other light sample, taken here.
+    /// test; on rough glass or a rough mirror so does any other light sample, taken here (a
+    /// constant sky's taken by the lanes, side by side).
     #[inline(always)]
     pub fn step(
         &mut self,
@@ -392,6 +393,8 @@ impl Path {
         // A light sample taken here for the rough glass or mirror lanes to evaluate the BSDF
         // towards (side by side, not a chain of dependent square roots and divisions).
         let mut given = None;
+        // The constant sky's sample, which those lanes take side by side.
+        let mut given_sky = false;
         if continuous {
             let choice = choose_light(scene, params, u_light_select);
             let quad = choice.filter(|(light, _, _)| {
@@ -400,14 +403,16 @@ impl Path {
                     && scene.objects[light.index as usize].kind == KIND_QUAD
             });
             let punctual = choice.filter(|(light, _, _)| lambert && is_delta_light(scene, light));
-            let sky = lambert && u_light_select < params.env_pmf && !has_env_map(params);
+            let sky = u_light_select < params.env_pmf && !has_env_map(params);
             if let Some((light, pmf, _)) = quad {
                 diffuse.push_quad_light(lane, scene, light.index, pmf, u_light, self.throughput);
             } else if let Some((light, pmf, _)) = punctual {
                 diffuse.push_punctual_light(lane, scene, &light, pmf, self.throughput);
-            } else if sky {
+            } else if sky && lambert {
                 let radiance = Vec3A::from(params.environment);
                 diffuse.push_sky_light(lane, radiance, params.env_pmf, u_light, self.throughput);
+            } else if sky && sampled_lanes.is_some() {
+                given_sky = true;
             } else if (lambert || sampled_lanes.is_some())
                 && choice.is_none()
                 && u_light_select < params.env_pmf
@@ -449,6 +454,14 @@ impl Path {
                     glass.push_light(lane, &ls);
                 } else {
                     glossy.push_light(lane, &ls);
+                }
+                *given_lights |= 1 << lane;
+            } else if given_sky {
+                let (radiance, pmf) = (Vec3A::from(params.environment), params.env_pmf);
+                if m.is_rough_glass() {
+                    glass.push_sky_light(lane, radiance, pmf, u_light);
+                } else {
+                    glossy.push_sky_light(lane, radiance, pmf, u_light);
                 }
                 *given_lights |= 1 << lane;
             }

@@ -71,6 +71,14 @@ pub(crate) fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     std::array::from_fn(|i| a[i] + b[i])
 }
 
+/// `sample_cosine_hemisphere([ux, uy])`.
+#[inline(always)]
+pub(crate) fn cosine_hemisphere(ux: f32, uy: f32) -> [f32; 3] {
+    let r = ux.sqrt();
+    let (sin, cos) = sin_cos_turns(uy);
+    [r * cos, r * sin, (1.0 - ux).max(0.0).sqrt()]
+}
+
 /// `Frame::around(n)`: tangent, bitangent, normal.
 #[inline(always)]
 pub(crate) fn frame_around(n: [f32; 3]) -> [[f32; 3]; 3] {
