@@ -18,10 +18,15 @@ use crate::packet::{Lanes, PACKET};
 use crate::slots::{Slots, in_groups};
 use crate::soa::{Lanes3, at, dot, lane, set_lane};
 
-/// Waiting lanes computed one by one rather than side by side: with four, env-sun,
-/// cornell-materials and lights rendered 2-3% sooner than with none or eight (a packet on
-/// a room's walls holds a lane or two on a sphere).
-const ONE_BY_ONE: usize = 4;
+/// Waiting lanes [`SampleLanes::compute`] computes one by one rather than side by side at the
+/// AVX-512 level: with four, env-sun, cornell-materials and lights rendered 2-3% sooner than
+/// with none or eight on a Zen 5 (a packet on a room's walls holds a lane or two on a
+/// sphere).
+pub const ONE_BY_ONE_WIDE: usize = 4;
+
+/// The same at AVX2 and below: none, every waiting lane side by side (on a Zen 3, untrained,
+/// env-sky, cornell-materials and env-sun 1.6-2.9% sooner than with four).
+pub const ONE_BY_ONE_NARROW: usize = 0;
 
 /// One lane's vertex, as a kind's sample reads it.
 #[derive(Debug, Clone, Copy)]
@@ -210,13 +215,14 @@ impl<M: LaneBsdf> SampleLanes<M> {
     }
 
     /// Computes the waiting lanes' samples and the evaluations towards their light samples:
-    /// up to `ONE_BY_ONE` slots one after another, more side by side in as many groups of
+    /// up to `one_by_one` slots one after another ([`ONE_BY_ONE_WIDE`],
+    /// [`ONE_BY_ONE_NARROW`]), more side by side in as many groups of
     /// [`GROUP`](crate::slots::GROUP) as they fill (the rest of the last group computes
     /// throw-away values).
     #[inline(always)]
-    pub fn compute(&mut self) {
+    pub fn compute(&mut self, one_by_one: usize) {
         let count = self.slots.count();
-        if count <= ONE_BY_ONE {
+        if count <= one_by_one {
             for k in 0..count {
                 self.compute_lane(k);
                 if self.lights.sky >> k & 1 != 0 {
@@ -453,7 +459,8 @@ pub(crate) mod tests {
                 };
                 cases.push((m, sample, light, sky_sample));
             }
-            lanes.compute();
+            // Both ways, whatever the count.
+            lanes.compute([0, ONE_BY_ONE_WIDE][round % 2]);
             assert_eq!(lanes.mask().count_ones() as usize, cases.len());
             let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
             for (l, (m, theirs, light, sky_sample)) in cases.iter().enumerate() {

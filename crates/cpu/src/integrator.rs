@@ -6,7 +6,7 @@ use pathlight_core::gpu_types::{
     GpuAccumPixel, GpuAovPixel, GpuRenderParams, KIND_QUAD, LIGHT_AREA, NO_LIGHT,
 };
 
-use crate::bsdf_lanes::{LaneBsdf, SampleLanes};
+use crate::bsdf_lanes::{LaneBsdf, ONE_BY_ONE_WIDE, SampleLanes};
 use crate::bvh::Hit;
 use crate::camera::camera_ray;
 use crate::cpu_scene::CpuScene;
@@ -158,18 +158,19 @@ impl ShadingLanes {
     }
 
     /// Takes the environment map's light samples left waiting
-    /// (`sample_map_lights`), then computes each kind's lanes.
+    /// (`sample_map_lights`), then computes each kind's lanes (up to `one_by_one` rough glass
+    /// or mirror lanes one after another: [`SampleLanes::compute`]).
     #[inline(always)]
-    pub fn compute(&mut self, scene: &CpuScene, params: &GpuRenderParams) {
+    pub fn compute(&mut self, scene: &CpuScene, params: &GpuRenderParams, one_by_one: usize) {
         self.sample_map_lights(scene, params);
         if self.diffuse.mask() != 0 {
             self.diffuse.compute();
         }
         if self.glass.mask() != 0 {
-            self.glass.compute();
+            self.glass.compute(one_by_one);
         }
         if self.glossy.mask() != 0 {
-            self.glossy.compute();
+            self.glossy.compute(one_by_one);
         }
     }
 
@@ -629,7 +630,7 @@ pub fn trace_path(
         let escaped = Lanes::from(hit.is_none());
         lanes.escape(scene, params, escaped, |_| path.ray.dir.to_array());
         let mut shadow = path.step(&mut sampler, scene, params, hit, &mut lanes, 0);
-        lanes.compute(scene, params);
+        lanes.compute(scene, params, ONE_BY_ONE_WIDE);
         if lanes.lights_left() != 0 {
             shadow = shadow.or(path.left_light_test(scene, params, &lanes, 0));
         }

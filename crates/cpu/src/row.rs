@@ -6,7 +6,7 @@ use std::ops::Range;
 use glam::{Vec3, Vec3A};
 use pathlight_core::gpu_types::{GpuAccumPixel, GpuAovPixel, GpuRenderParams};
 
-use crate::bsdf_lanes::{LaneBsdf, SampleLanes};
+use crate::bsdf_lanes::{LaneBsdf, ONE_BY_ONE_NARROW, ONE_BY_ONE_WIDE, SampleLanes};
 use crate::camera::{film_point, lens_ray, primary_directions};
 use crate::cpu_scene::CpuScene;
 use crate::integrator::{
@@ -71,7 +71,8 @@ impl std::iter::Sum for Tally {
 /// sample. The whole path tracer is inlined here, so that each [`InstructionSet`] level
 /// compiles all of it. `WIDE`: the level has AVX-512's 32 registers of sixteen lanes, worth
 /// computing two paths' sampler windows at once (with AVX2's sixteen registers they cost
-/// the furnace 7%: spilled).
+/// the furnace 7%: spilled), and a few rough glass or mirror lanes one by one rather than
+/// side by side ([`ONE_BY_ONE_WIDE`], [`ONE_BY_ONE_NARROW`]).
 #[inline(always)]
 fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut RowTotals) -> Tally {
     let (scene, params) = (job.scene, job.params);
@@ -154,7 +155,12 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
             let shadow = paths[l].step(sampler, scene, params, Some(hit), &mut shading, l);
             shadow_tests.add(l, shadow);
         }
-        shading.compute(scene, params);
+        let one_by_one = if WIDE {
+            ONE_BY_ONE_WIDE
+        } else {
+            ONE_BY_ONE_NARROW
+        };
+        shading.compute(scene, params, one_by_one);
         let mut left = shading.lights_left();
         while left != 0 {
             let l = left.trailing_zeros() as usize;
