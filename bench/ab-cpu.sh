@@ -30,6 +30,7 @@
 #     left out but furnace-0.8)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source bench/common.sh
 ROUNDS=8 SPP=128 RES=256 ALONE=false COUNT=false ARGS=()
 while [ $# -gt 0 ]; do
     case "$1" in
@@ -47,24 +48,13 @@ if [ ${#ARGS[@]} -lt 2 ]; then
     exit 2
 fi
 BASE=${ARGS[0]} NEW=${ARGS[1]}
-for bin in "$BASE" "$NEW"; do
-    [ -x "$bin" ] || { echo "not an executable: $bin" >&2; exit 1; }
-done
+require_executables "$BASE" "$NEW"
 if [ "$(nproc)" -lt 2 ]; then
     echo "needs two CPUs (this machine has $(nproc)): the builds run side by side" >&2
     exit 1
 fi
 SCENES=()
-for name in "${ARGS[@]:2}"; do
-    if [ -f "$name" ]; then
-        SCENES+=("$name")
-    elif [ -f "scenes/refs/$name.toml" ]; then
-        SCENES+=("scenes/refs/$name.toml")
-    else
-        echo "no such scene: $name (neither a file nor scenes/refs/$name.toml)" >&2
-        exit 1
-    fi
-done
+add_scenes "${ARGS[@]:2}"
 if [ ${#SCENES[@]} -eq 0 ]; then
     for f in scenes/refs/*.toml; do
         name=$(basename "$f" .toml)

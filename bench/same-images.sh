@@ -12,6 +12,7 @@
 #     BASE, NEW: pathlight binaries; SCENE: a name in scenes/refs or a path to a scene file
 set -euo pipefail
 cd "$(dirname "$0")/.."
+source bench/common.sh
 RES=64 SPP=16 ARGS=()
 while [ $# -gt 0 ]; do
     case "$1" in
@@ -26,20 +27,9 @@ if [ ${#ARGS[@]} -lt 2 ]; then
     exit 2
 fi
 BASE=${ARGS[0]} NEW=${ARGS[1]}
-for bin in "$BASE" "$NEW"; do
-    [ -x "$bin" ] || { echo "not an executable: $bin" >&2; exit 1; }
-done
+require_executables "$BASE" "$NEW"
 SCENES=()
-for name in "${ARGS[@]:2}"; do
-    if [ -f "$name" ]; then
-        SCENES+=("$name")
-    elif [ -f "scenes/refs/$name.toml" ]; then
-        SCENES+=("scenes/refs/$name.toml")
-    else
-        echo "no such scene: $name (neither a file nor scenes/refs/$name.toml)" >&2
-        exit 1
-    fi
-done
+add_scenes "${ARGS[@]:2}"
 if [ ${#SCENES[@]} -eq 0 ]; then
     SCENES=(scenes/refs/*.toml scenes/*.toml)
 fi
