@@ -38,7 +38,7 @@ fn main() -> ExitCode {
             ExitCode::from(render::Interrupted::EXIT_CODE)
         }
         Err(err) => {
-            note!("error: {err:#}");
+            note!("error: {}", pathlight_core::error_message(err.as_ref()));
             ExitCode::FAILURE
         }
     }

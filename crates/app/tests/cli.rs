@@ -131,7 +131,14 @@ fn png_output_of_the_default_scene() {
 
 #[test]
 fn missing_and_malformed_scene_files() {
-    fails_with(&["render", "no/such/scene.toml"], &["no/such/scene.toml"]);
+    let err = fails_with(&["render", "no/such/scene.toml"], &["no/such/scene.toml"]);
+    // The file's error names the system's reason, which is said once.
+    let line = err.lines().find(|l| l.contains("scene.toml")).unwrap();
+    let parts: Vec<&str> = line.split(": ").collect();
+    assert!(
+        parts.windows(2).all(|w| w[0] != w[1]),
+        "a cause said twice: {line}"
+    );
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("bad.toml");
     std::fs::write(

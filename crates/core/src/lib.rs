@@ -26,7 +26,7 @@ pub mod tonemap;
 
 pub use accumulation::{Accumulation, SampleCursor};
 pub use environment::EnvironmentData;
-pub use error::{GeometryError, RenderError};
+pub use error::{GeometryError, RenderError, error_message};
 pub use film::Film;
 pub use geometry::Geometry;
 pub use prepared::PreparedScene;
