@@ -691,9 +691,15 @@ impl FixedSum {
         // part is WGSL's floor(v) * 2^32 + trunc(fract(v) * 2^32): the same fixed-point
         // number, converted once instead of in two halves. At most 2^56, it converts exactly
         // as a signed number too: on AVX2 one instruction, where the unsigned is a dozen.
+        // Not a number counts as zero, as `as` converts it.
+        let value = Vec3A::select(value.cmpeq(value), value, Vec3A::ZERO);
         let scaled = value.clamp(Vec3A::ZERO, Vec3A::splat(SAMPLE_MAX)) * 4_294_967_296.0;
         for (sum, x) in self.0.iter_mut().zip(scaled.to_array()) {
-            *sum = sum.saturating_add(x as i64 as u64);
+            // SAFETY: `x` is a number in [0, 2^56], so its integer part is an `i64`. `as`
+            // would check for numbers out of range, a branch each; without them AVX-512
+            // converts the channels together (+4% on the furnace, whose samples are short).
+            let integer = unsafe { x.to_int_unchecked::<i64>() };
+            *sum = sum.saturating_add(integer as u64);
         }
     }
 
