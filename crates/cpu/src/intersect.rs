@@ -62,8 +62,11 @@ pub fn intersect_quad(origin: Vec3, eu: Vec3, ev: Vec3, ray: &Ray, t_max: f32) -
         return (MISS, 0.0, 0.0);
     }
     let p = ray.origin + t * ray.dir - origin;
-    let s = p.cross(ev).dot(n) / nn;
-    let r = eu.cross(p).dot(n) / nn;
+    // (p x ev) . n / nn and (eu x p) . n / nn as dot products with the quad's dual edges,
+    // which depend on the quad alone: a packet's test makes them once for all its rays.
+    let inv_nn = 1.0 / nn;
+    let s = p.dot(ev.cross(n) * inv_nn);
+    let r = p.dot(n.cross(eu) * inv_nn);
     if !(0.0..=1.0).contains(&s) || !(0.0..=1.0).contains(&r) {
         return (MISS, 0.0, 0.0);
     }

@@ -53,8 +53,10 @@ fn intersect_quad(origin: vec3f, eu: vec3f, ev: vec3f, ray: Ray, t_max: f32) -> 
         return vec3f(MISS, 0.0, 0.0);
     }
     let p = ray.origin + t * ray.dir - origin;
-    let s = dot(cross(p, ev), n) / nn;
-    let r = dot(cross(eu, p), n) / nn;
+    // (p x ev) . n / nn and (eu x p) . n / nn as dot products with the quad's dual edges.
+    let inv_nn = 1.0 / nn;
+    let s = dot(p, cross(ev, n) * inv_nn);
+    let r = dot(p, cross(n, eu) * inv_nn);
     if s < 0.0 || s > 1.0 || r < 0.0 || r > 1.0 {
         return vec3f(MISS, 0.0, 0.0);
     }
