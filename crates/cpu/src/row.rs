@@ -103,7 +103,7 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
         }
         let started = packet.active & !occupied;
         occupied = packet.active;
-        tracer.intersect_packet(&packet, &mut hits);
+        tracer.intersect_packet::<WIDE>(&packet, &mut hits);
         let RowLanes {
             paths,
             samplers,
@@ -177,7 +177,7 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
         leave_sampled(paths, &shading.glass, params);
         leave_sampled(paths, &shading.glossy, params);
         let unblocked = shadow_tests.unblocked;
-        let blocked = tracer.occluded_packet(&shadows);
+        let blocked = tracer.occluded_packet::<WIDE>(&shadows);
         // Each lane's outcome as a bit first, then a loop over each outcome's lanes: a branch
         // per lane on whether its path ended, which comes at random, cost lights 5%
         // (mispredicted, presumably).

@@ -50,23 +50,29 @@ impl<'a> Tracer<'a> {
     }
 
     /// Nearest hit in `(0, t_max)` of each active ray of `packet` (none for the others),
-    /// into `hits`.
+    /// into `hits`. `WIDE`: the caller's level has AVX-512 (its shape tests take sixteen
+    /// lanes at once, not eight).
     #[inline(always)]
-    pub fn intersect_packet(&mut self, packet: &RayPacket, hits: &mut PacketHits) {
-        self.walk_packet(packet, false, Some(hits));
+    pub fn intersect_packet<const WIDE: bool>(
+        &mut self,
+        packet: &RayPacket,
+        hits: &mut PacketHits,
+    ) {
+        self.walk_packet::<WIDE>(packet, false, Some(hits));
     }
 
-    /// Bit `l` set: something lies on active ray `l` of `packet` in `(0, t_max)`.
+    /// Bit `l` set: something lies on active ray `l` of `packet` in `(0, t_max)`. `WIDE` as
+    /// for [`Tracer::intersect_packet`].
     #[inline(always)]
-    pub fn occluded_packet(&mut self, packet: &RayPacket) -> Lanes {
+    pub fn occluded_packet<const WIDE: bool>(&mut self, packet: &RayPacket) -> Lanes {
         // Only traced lanes can have found something.
-        self.walk_packet(packet, true, None).found()
+        self.walk_packet::<WIDE>(packet, true, None).found()
     }
 
     /// Walks the active rays of `packet` through the scene's tree, for their nearest hits
     /// or (`any_hit`) any, into `hits` or else the shadow queries' own; returns those.
     #[inline(always)]
-    fn walk_packet<'s>(
+    fn walk_packet<'s, const WIDE: bool>(
         &'s mut self,
         packet: &RayPacket,
         any_hit: bool,
@@ -77,7 +83,7 @@ impl<'a> Tracer<'a> {
         hits.reset(packet, active);
         if !self.scene.primitives.is_empty() && active != 0 {
             self.rays.set(packet, !self.scene.triangles.is_empty());
-            let walk = PacketWalk {
+            let walk = PacketWalk::<WIDE> {
                 scene: self.scene,
                 rays: &self.rays,
                 any_hit,
