@@ -240,3 +240,72 @@ pub fn intersect_triangle(
     }
     (t, e1 * inv_det, e2 * inv_det)
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+    use rand::rngs::StdRng;
+    use rand::{Rng, SeedableRng};
+
+    use super::*;
+
+    /// A random vector with coordinates in [-1, 1).
+    fn random_vec(rng: &mut StdRng) -> Vec3 {
+        Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        )
+    }
+
+    /// On random parallelograms (skewed, of any size from 0.01 to 100), a ray from a random
+    /// point towards `origin + s eu + t ev` hits it at that distance with those parameters
+    /// (to 1e-4 of the parameters' range), from either side; aimed 1% of an edge outside any
+    /// of its four sides, it misses; and it misses beyond `t_max`.
+    #[test]
+    fn quads_give_the_parameters_of_the_point_hit() {
+        let mut rng = StdRng::seed_from_u64(7);
+        for _ in 0..20_000 {
+            let scale = 10f32.powf(rng.random_range(-2.0..2.0));
+            let (origin, eu, ev) = (
+                random_vec(&mut rng) * scale,
+                random_vec(&mut rng) * scale,
+                random_vec(&mut rng) * scale,
+            );
+            let n = eu.cross(ev);
+            // Edges at least a tenth of a radian from parallel: the parameters are well posed.
+            if n.length() < 0.1 * eu.length() * ev.length() {
+                continue;
+            }
+            let (s, t) = (rng.random_range(0.01..0.99), rng.random_range(0.01..0.99));
+            let target = origin + s * eu + t * ev;
+            let from = target + random_vec(&mut rng) * 2.0 * scale;
+            let dir = (target - from).normalize();
+            // Grazing rays make the hit's distance ill-conditioned.
+            if dir.dot(n.normalize()).abs() < 0.1 {
+                continue;
+            }
+            let ray = Ray::new(from, dir);
+            let distance = (target - from).length();
+            let (hit, hs, ht) = intersect_quad(origin, eu, ev, &ray, f32::INFINITY);
+            assert!(
+                (hit - distance).abs() <= 1e-4 * distance.max(scale)
+                    && (hs - s).abs() <= 1e-4
+                    && (ht - t).abs() <= 1e-4,
+                "hit ({hit}, {hs}, {ht}), want ({distance}, {s}, {t}): {origin} {eu} {ev} {ray:?}"
+            );
+            let (before, _, _) = intersect_quad(origin, eu, ev, &ray, 0.99 * distance);
+            assert_eq!(before, MISS, "beyond t_max: {origin} {eu} {ev} {ray:?}");
+            for outside in [
+                origin - 0.01 * eu + t * ev,
+                origin + 1.01 * eu + t * ev,
+                origin + s * eu - 0.01 * ev,
+                origin + s * eu + 1.01 * ev,
+            ] {
+                let ray = Ray::new(from, (outside - from).normalize());
+                let (miss, _, _) = intersect_quad(origin, eu, ev, &ray, f32::INFINITY);
+                assert_eq!(miss, MISS, "outside: {outside} {origin} {eu} {ev} {ray:?}");
+            }
+        }
+    }
+}
