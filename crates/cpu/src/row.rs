@@ -14,7 +14,7 @@ use crate::integrator::{
 };
 use crate::intersect::Ray;
 use crate::packet::{Lanes, PACKET, PacketHits, RayPacket};
-use crate::sampler::{CameraPoints, PixelSamplers, Sampler};
+use crate::sampler::{CameraPoints, PixelSamplers, Sampler, SeedCache};
 use crate::tracer::Tracer;
 
 /// A row's running sums: the colour's, and the auxiliary images' (empty when the render has
@@ -120,13 +120,19 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
                 }
                 None => samplers[a].prepare_first(),
             });
-            prepare_windows(samplers, found & occupied);
+            prepare_windows(samplers, found & occupied, &mut starter.seeds);
         } else {
             let mut left = found & started;
             while left != 0 {
                 let l = left.trailing_zeros() as usize;
                 left &= left - 1;
                 samplers[l].prepare_first();
+            }
+            let mut left = found & occupied & !started;
+            while left != 0 {
+                let l = left.trailing_zeros() as usize;
+                left &= left - 1;
+                samplers[l].prepare_cached(&mut starter.seeds);
             }
         }
         shading.escape(scene, params, occupied & !found, |l| {
@@ -219,9 +225,9 @@ struct RowLanes {
 
 /// Computes the windows due of the `samplers` in `going_on` (those whose path's ray hit
 /// something: their next bounce draws from it), two side by side at a time
-/// ([`Sampler::prepare_pair`]); an odd one left is computed by its bounce ([`Path::step`]).
+/// ([`Sampler::prepare_pair`]), an odd one left alone, their scrambles' seeds from `seeds`.
 #[inline(always)]
-fn prepare_windows(samplers: &mut [Sampler; PACKET], going_on: Lanes) {
+fn prepare_windows(samplers: &mut [Sampler; PACKET], going_on: Lanes, seeds: &mut SeedCache) {
     let mut due: Lanes = 0;
     let mut left = going_on;
     while left != 0 {
@@ -229,13 +235,21 @@ fn prepare_windows(samplers: &mut [Sampler; PACKET], going_on: Lanes) {
         left &= left - 1;
         due |= Lanes::from(samplers[l].window_due()) << l;
     }
-    in_pairs(due, |a, b| {
-        if let Some(b) = b
-            && let Ok([sampler_a, sampler_b]) = samplers.get_disjoint_mut([a, b])
-        {
-            Sampler::prepare_pair(sampler_a, sampler_b);
+    // A loop rather than `in_pairs`, whose closure the compiler left out of line here
+    // (compiled for the baseline: cornell-diffuse 0.66 times as fast).
+    while due != 0 {
+        let a = due.trailing_zeros() as usize;
+        due &= due - 1;
+        if due == 0 {
+            samplers[a].prepare_cached(seeds);
+            break;
         }
-    });
+        let b = due.trailing_zeros() as usize;
+        due &= due - 1;
+        if let Ok([sampler_a, sampler_b]) = samplers.get_disjoint_mut([a, b]) {
+            Sampler::prepare_pair(sampler_a, sampler_b, seeds);
+        }
+    }
 }
 
 /// Calls `pair` with the lanes of `lanes` two by two, lowest first, and an odd one left
@@ -301,6 +315,8 @@ struct Starter<'a> {
     pinhole: bool,
     /// The camera's sample values of the samples starting.
     camera: CameraPoints,
+    /// The scrambles' seeds of the pixels started last.
+    seeds: SeedCache,
     /// Per lane, of the sample starting there: its film point (for a pinhole) or camera ray
     /// (with a lens).
     film_x: [f32; PACKET],
@@ -312,11 +328,14 @@ impl<'a> Starter<'a> {
     #[inline(always)]
     fn new(job: &'a RowJob<'a>, width: usize) -> Self {
         let params = job.params;
+        let mut seeds = SeedCache::default();
+        let mut pixel = PixelSamplers::new(params.sampler, job.y * params.width, params.seed);
+        seeds.begin(&mut pixel);
         Self {
             job,
             width,
             column: if job.samples.is_empty() { width } else { 0 },
-            pixel: PixelSamplers::new(params.sampler, job.y * params.width, params.seed),
+            pixel,
             index: job.samples.start,
             pinhole: params.camera.lens_radius <= 0.0,
             camera: CameraPoints::new(if params.camera.lens_radius <= 0.0 {
@@ -327,6 +346,7 @@ impl<'a> Starter<'a> {
             film_x: [0.0; PACKET],
             film_y: [0.0; PACKET],
             lens_rays: RayPacket::default().rays,
+            seeds,
         }
     }
 
@@ -365,6 +385,7 @@ impl<'a> Starter<'a> {
                     if self.column != self.width {
                         let pixel = job.y * params.width + self.column as u32;
                         self.pixel = PixelSamplers::new(params.sampler, pixel, params.seed);
+                        self.seeds.begin(&mut self.pixel);
                     }
                 }
             }

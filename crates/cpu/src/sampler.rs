@@ -119,6 +119,8 @@ pub struct Sampler {
     /// The window from `ahead_from` is due: not computed yet ([`Sampler::prepare`] or the
     /// next request computes it).
     due: bool,
+    /// Sobol: its pixel's slot in a row's [`SeedCache`].
+    seed_slot: u8,
 }
 
 /// What the samplers of one pixel share, hashed once for all its samples (the row renderer
@@ -133,6 +135,8 @@ pub struct PixelSamplers {
     /// Sobol: the scrambles' seeds of the first window's dimensions (0 to [`LANES`] - 1),
     /// which depend on the pixel alone.
     first_seeds: ScrambleSeeds<LANES>,
+    /// Sobol: its slot in a row's [`SeedCache`] ([`SeedCache::begin`]).
+    seed_slot: u8,
 }
 
 /// The seeds of the three Owen scrambles of `N` Sobol dimensions' values, per lane: of the
@@ -145,6 +149,21 @@ struct ScrambleSeeds<const N: usize> {
 }
 
 impl<const N: usize> ScrambleSeeds<N> {
+    /// All zero.
+    const ZERO: Self = Self {
+        index: [0; N],
+        x: [0; N],
+        y: [0; N],
+    };
+
+    /// Copies `other`'s seeds into lanes `at..at + M`.
+    #[inline(always)]
+    fn put<const M: usize>(&mut self, at: usize, other: &ScrambleSeeds<M>) {
+        self.index[at..at + M].copy_from_slice(&other.index);
+        self.x[at..at + M].copy_from_slice(&other.x);
+        self.y[at..at + M].copy_from_slice(&other.y);
+    }
+
     /// Lane `i`'s seeds for the dimension whose hash is `dimension_hash[i]` in the pixel
     /// whose seed is `pixel_seed[i]`.
     #[inline(always)]
@@ -177,6 +196,7 @@ impl PixelSamplers {
             seed,
             pixel_seed,
             first_seeds: ScrambleSeeds::new(&[pixel_seed; LANES], &hashes),
+            seed_slot: 0,
         }
     }
 
@@ -196,6 +216,7 @@ impl PixelSamplers {
             first_seeds: self.first_seeds,
             ahead_from: 0,
             due: false,
+            seed_slot: 0,
         };
         sampler.restart(self, index);
         sampler
@@ -224,6 +245,7 @@ impl Sampler {
             rng_init(pixel.pixel, index, pixel.seed)
         };
         self.first_seeds = pixel.first_seeds;
+        self.seed_slot = pixel.seed_slot;
         // The camera's dimensions and the first bounce's come from the window at 0.
         self.ahead_from = 0;
         self.due = sobol;
@@ -307,27 +329,49 @@ impl Sampler {
         self.due
     }
 
-    /// [`Sampler::prepare`] of `a` and `b`, their windows computed side by side when both
-    /// are due: sixteen lanes, one AVX-512 register an operation, so that a window costs
+    /// [`Sampler::prepare`], the scrambles' seeds taken from `cache` where it holds them.
+    #[inline(always)]
+    pub fn prepare_cached(&mut self, cache: &mut SeedCache) {
+        if self.due {
+            let mut seeds = ScrambleSeeds::<LANES>::ZERO;
+            self.window_seeds(cache, &mut seeds, 0);
+            self.ahead = scrambled_sobol(&[self.index_reversed; LANES], &seeds);
+            self.due = false;
+        }
+    }
+
+    /// Puts the scrambles' seeds of the window due into lanes `at..at + LANES` of `seeds`:
+    /// from `cache` where it holds them, else computed.
+    #[inline(always)]
+    fn window_seeds<const N: usize>(
+        &self,
+        cache: &mut SeedCache,
+        seeds: &mut ScrambleSeeds<N>,
+        at: usize,
+    ) {
+        if !cache.window(self.seed_slot, self.pixel_seed, self.ahead_from, seeds, at) {
+            let mut hashes = [0u32; LANES];
+            dimension_hashes(self.ahead_from, &mut hashes);
+            seeds.put(at, &ScrambleSeeds::new(&[self.pixel_seed; LANES], &hashes));
+        }
+    }
+
+    /// [`Sampler::prepare_cached`] of `a` and `b`, their windows computed side by side when
+    /// both are due: sixteen lanes, one AVX-512 register an operation, so that a window costs
     /// half the instructions where the registers are that wide (with AVX2's, the CPU backend
     /// does not pair them: twice the registers live, spilled).
     #[inline(always)]
-    pub fn prepare_pair(a: &mut Self, b: &mut Self) {
+    pub fn prepare_pair(a: &mut Self, b: &mut Self, cache: &mut SeedCache) {
         if !(a.due && b.due) {
-            a.prepare();
-            b.prepare();
+            a.prepare_cached(cache);
+            b.prepare_cached(cache);
             return;
         }
-        let mut pixel_seed = [a.pixel_seed; 2 * LANES];
         let mut index_reversed = [a.index_reversed; 2 * LANES];
-        let mut hashes = [0u32; 2 * LANES];
-        dimension_hashes(a.ahead_from, &mut hashes[..LANES]);
-        dimension_hashes(b.ahead_from, &mut hashes[LANES..]);
-        for i in LANES..2 * LANES {
-            pixel_seed[i] = b.pixel_seed;
-            index_reversed[i] = b.index_reversed;
-        }
-        let seeds = ScrambleSeeds::new(&pixel_seed, &hashes);
+        index_reversed[LANES..].fill(b.index_reversed);
+        let mut seeds = ScrambleSeeds::<{ 2 * LANES }>::ZERO;
+        a.window_seeds(cache, &mut seeds, 0);
+        b.window_seeds(cache, &mut seeds, LANES);
         a.take_pair_half(b, &scrambled_sobol(&index_reversed, &seeds));
     }
 
@@ -412,6 +456,96 @@ impl Sampler {
         dimension_hashes(first, &mut hashes);
         let seeds = ScrambleSeeds::new(&[self.pixel_seed; LANES], &hashes);
         scrambled_sobol(&[self.index_reversed; LANES], &seeds)
+    }
+}
+
+/// Pixels whose seeds a [`SeedCache`] holds at once.
+const CACHED_PIXELS: usize = 4;
+/// Dimensions whose seeds a [`SeedCache`] holds per pixel: a path of ten bounces.
+const CACHED_DIMENSIONS: usize = 64;
+
+/// The scrambles' seeds of the Sobol dimensions of the last few pixels a row started (three
+/// `pcg_hash`es a dimension), computed once per pixel as its first sample to reach a window
+/// needs them, not once per sample. A sampler finds its pixel's by the slot its pixel took
+/// ([`SeedCache::begin`]); where that slot went to a newer pixel since (over
+/// [`CACHED_PIXELS`] pixels started while its path went on: a few samples a pixel), or past
+/// [`CACHED_DIMENSIONS`], the seeds are computed as before. They depend on the pixel's seed
+/// and the dimension alone: the values drawn are the same bit for bit.
+#[derive(Debug, Clone)]
+pub struct SeedCache {
+    pixels: [CachedSeeds; CACHED_PIXELS],
+    /// The slot the next pixel takes.
+    next: usize,
+}
+
+/// A pixel's seeds in a [`SeedCache`].
+#[derive(Debug, Clone)]
+struct CachedSeeds {
+    /// The pixel's seed (which seeds every scramble).
+    pixel_seed: u32,
+    /// The dimensions below hold their seeds (a multiple of [`LANES`]).
+    filled: usize,
+    seeds: ScrambleSeeds<CACHED_DIMENSIONS>,
+}
+
+impl Default for SeedCache {
+    #[inline(always)]
+    fn default() -> Self {
+        Self {
+            pixels: [const {
+                CachedSeeds {
+                    pixel_seed: 0,
+                    filled: 0,
+                    seeds: ScrambleSeeds::ZERO,
+                }
+            }; CACHED_PIXELS],
+            next: 0,
+        }
+    }
+}
+
+impl SeedCache {
+    /// Gives `pixel`, whose samples start now, the next slot (the oldest pixel's), with its
+    /// first window's seeds.
+    #[inline(always)]
+    pub fn begin(&mut self, pixel: &mut PixelSamplers) {
+        let slot = self.next;
+        self.next = (slot + 1) % CACHED_PIXELS;
+        let cached = &mut self.pixels[slot];
+        cached.pixel_seed = pixel.pixel_seed;
+        cached.seeds.put(0, &pixel.first_seeds);
+        cached.filled = LANES;
+        pixel.seed_slot = slot as u8;
+    }
+
+    /// Puts the seeds of the [`LANES`] dimensions from `first` of the pixel of seed
+    /// `pixel_seed` into lanes `at..at + LANES` of `seeds`, if slot `slot` still holds that
+    /// pixel (computing those not held yet); returns whether it did.
+    #[inline(always)]
+    fn window<const N: usize>(
+        &mut self,
+        slot: u8,
+        pixel_seed: u32,
+        first: u32,
+        seeds: &mut ScrambleSeeds<N>,
+        at: usize,
+    ) -> bool {
+        let cached = &mut self.pixels[usize::from(slot) % CACHED_PIXELS];
+        let (first, end) = (first as usize, first as usize + LANES);
+        if cached.pixel_seed != pixel_seed || end > CACHED_DIMENSIONS {
+            return false;
+        }
+        while cached.filled < end {
+            let mut hashes = [0u32; LANES];
+            dimension_hashes(cached.filled as u32, &mut hashes);
+            let group = ScrambleSeeds::new(&[pixel_seed; LANES], &hashes);
+            cached.seeds.put(cached.filled, &group);
+            cached.filled += LANES;
+        }
+        seeds.index[at..at + LANES].copy_from_slice(&cached.seeds.index[first..end]);
+        seeds.x[at..at + LANES].copy_from_slice(&cached.seeds.x[first..end]);
+        seeds.y[at..at + LANES].copy_from_slice(&cached.seeds.y[first..end]);
+        true
     }
 }
 
@@ -667,12 +801,55 @@ mod tests {
                 }
             }
             let (mut alone_a, mut alone_b) = (a.clone(), b.clone());
-            Sampler::prepare_pair(&mut a, &mut b);
+            Sampler::prepare_pair(&mut a, &mut b, &mut SeedCache::default());
             assert!(!a.window_due() && !b.window_due());
             for _ in 0..3 {
                 assert_eq!(a.next_batch(draws), alone_a.next_batch(draws), "{skip_a}");
                 assert_eq!(b.next_batch(draws), alone_b.next_batch(draws), "{skip_b}");
             }
+        }
+    }
+
+    #[test]
+    fn windows_through_the_seed_cache_draw_what_samplers_draw_alone() {
+        // Samplers of more pixels than the cache holds (the first ones' slots taken by later
+        // pixels since), alone and in pairs (of one pixel, of two, one of them no longer
+        // held), drawing bounce after bounce past the dimensions the cache holds: every
+        // window draws what a sampler of its own draws.
+        let mut cache = SeedCache::default();
+        let pixels: Vec<PixelSamplers> = (0..CACHED_PIXELS as u32 + 3)
+            .map(|p| {
+                let mut pixel = PixelSamplers::new(SAMPLER_SOBOL, 100 + p, 9);
+                cache.begin(&mut pixel);
+                pixel
+            })
+            .collect();
+        let last = pixels.len() - 1;
+        let cases = [
+            (last, 3, Some((last, 4))),
+            (last, 5, Some((0, 6))),
+            (1, 7, None),
+        ];
+        for (pixel_a, index_a, b) in cases {
+            let sampler = |pixel: usize, index: u32| {
+                let alone = Sampler::new(SAMPLER_SOBOL, 100 + pixel as u32, index, 9);
+                (pixels[pixel].sampler(index), alone)
+            };
+            let (mut a, mut alone_a) = sampler(pixel_a, index_a);
+            let mut b = b.map(|(pixel, index)| sampler(pixel, index));
+            for bounce in 0..14 {
+                match &mut b {
+                    Some((b, _)) => Sampler::prepare_pair(&mut a, b, &mut cache),
+                    None => a.prepare_cached(&mut cache),
+                }
+                assert!(!a.window_due(), "bounce {bounce}");
+                let draws = BOUNCE_DRAWS;
+                assert_eq!(a.next_batch(draws), alone_a.next_batch(draws), "{bounce}");
+                if let Some((b, alone_b)) = &mut b {
+                    assert_eq!(b.next_batch(draws), alone_b.next_batch(draws), "{bounce}");
+                }
+            }
+            assert!(a.dimension as usize > CACHED_DIMENSIONS + LANES);
         }
     }
 
