@@ -101,7 +101,6 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
         if packet.active == 0 {
             return tally;
         }
-        let started = packet.active & !occupied;
         occupied = packet.active;
         tracer.intersect_packet::<WIDE>(&packet, &mut hits);
         let RowLanes {
@@ -110,25 +109,12 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
             columns,
         } = &mut lanes;
         let found = hits.found();
-        // The first windows of the new paths that go on, from their pixels' seeds.
+        // The windows due of the paths that go on (a new path's first among them), their
+        // seeds from the row's cache.
         if WIDE {
-            in_pairs(found & started, |a, b| match b {
-                Some(b) => {
-                    if let Ok([sampler_a, sampler_b]) = samplers.get_disjoint_mut([a, b]) {
-                        Sampler::prepare_first_pair(sampler_a, sampler_b);
-                    }
-                }
-                None => samplers[a].prepare_first(),
-            });
             prepare_windows(samplers, found & occupied, &mut starter.seeds);
         } else {
-            let mut left = found & started;
-            while left != 0 {
-                let l = left.trailing_zeros() as usize;
-                left &= left - 1;
-                samplers[l].prepare_first();
-            }
-            let mut left = found & occupied & !started;
+            let mut left = found & occupied;
             while left != 0 {
                 let l = left.trailing_zeros() as usize;
                 left &= left - 1;
@@ -235,7 +221,7 @@ fn prepare_windows(samplers: &mut [Sampler; PACKET], going_on: Lanes, seeds: &mu
         left &= left - 1;
         due |= Lanes::from(samplers[l].window_due()) << l;
     }
-    // A loop rather than `in_pairs`, whose closure the compiler left out of line here
+    // A loop, not a closure called per pair, which the compiler left out of line here
     // (compiled for the baseline: cornell-diffuse 0.66 times as fast).
     while due != 0 {
         let a = due.trailing_zeros() as usize;
@@ -249,19 +235,6 @@ fn prepare_windows(samplers: &mut [Sampler; PACKET], going_on: Lanes, seeds: &mu
         if let Ok([sampler_a, sampler_b]) = samplers.get_disjoint_mut([a, b]) {
             Sampler::prepare_pair(sampler_a, sampler_b, seeds);
         }
-    }
-}
-
-/// Calls `pair` with the lanes of `lanes` two by two, lowest first, and an odd one left
-/// alone (`None` beside it).
-#[inline(always)]
-fn in_pairs(mut lanes: Lanes, mut pair: impl FnMut(usize, Option<usize>)) {
-    while lanes != 0 {
-        let a = lanes.trailing_zeros() as usize;
-        lanes &= lanes - 1;
-        let b = (lanes != 0).then(|| lanes.trailing_zeros() as usize);
-        lanes &= lanes.wrapping_sub(1);
-        pair(a, b);
     }
 }
 
@@ -363,7 +336,7 @@ impl<'a> Starter<'a> {
     /// those holding a path), their camera rays into `packet`; a path that ends at once
     /// (max_depth 0) is added to `row` and hands its lane to the next sample. Returns what
     /// those did. A new path's first sampler window is left due: computed once its camera
-    /// ray is known to meet something ([`Sampler::prepare_first`]).
+    /// ray is known to meet something ([`Sampler::prepare_cached`]).
     #[inline(always)]
     fn fill(&mut self, lanes: &mut RowLanes, packet: &mut RayPacket, row: &mut RowTotals) -> Tally {
         let (job, params) = (self.job, self.job.params);

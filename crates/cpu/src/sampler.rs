@@ -108,12 +108,10 @@ pub struct Sampler {
     rng_state: u32,
     /// Sobol: the values of the [`LANES`] dimensions from `ahead_from`, per coordinate,
     /// the window [`Sampler::next_batch`] serves from, computed ahead of their use
-    /// ([`Sampler::prepare`], or two samplers' at once, [`Sampler::prepare_pair`]; a new
-    /// sampler's first from its pixel's seeds, [`Sampler::prepare_first`]) so that
-    /// their hash chains' latency overlaps the shading that comes between.
+    /// ([`Sampler::prepare`], or with a row's [`SeedCache`], [`Sampler::prepare_cached`], or
+    /// two samplers' at once, [`Sampler::prepare_pair`]) so that their hash chains' latency
+    /// overlaps the shading that comes between.
     ahead: Window<LANES>,
-    /// Sobol: the scrambles' seeds of the first window's dimensions (its pixel's).
-    first_seeds: ScrambleSeeds<LANES>,
     /// The first dimension in `ahead`.
     ahead_from: u32,
     /// The window from `ahead_from` is due: not computed yet ([`Sampler::prepare`] or the
@@ -213,7 +211,6 @@ impl PixelSamplers {
                 x: [0.0; LANES],
                 y: [0.0; LANES],
             },
-            first_seeds: self.first_seeds,
             ahead_from: 0,
             due: false,
             seed_slot: 0,
@@ -244,7 +241,6 @@ impl Sampler {
         } else {
             rng_init(pixel.pixel, index, pixel.seed)
         };
-        self.first_seeds = pixel.first_seeds;
         self.seed_slot = pixel.seed_slot;
         // The camera's dimensions and the first bounce's come from the window at 0.
         self.ahead_from = 0;
@@ -271,43 +267,6 @@ impl Sampler {
             self.ahead = self.sobol_lanes(self.ahead_from);
             self.due = false;
         }
-    }
-
-    /// [`Sampler::prepare`] of a new sampler (its first window, from dimension 0), from its
-    /// pixel's scrambles' seeds, which it keeps.
-    #[inline(always)]
-    pub fn prepare_first(&mut self) {
-        if self.due {
-            debug_assert_eq!(self.ahead_from, 0, "not a new sampler");
-            self.ahead = scrambled_sobol(&[self.index_reversed; LANES], &self.first_seeds);
-            self.due = false;
-        }
-    }
-
-    /// [`Sampler::prepare_first`] of `a` and `b`, side by side as [`Sampler::prepare_pair`]
-    /// computes them.
-    #[inline(always)]
-    pub fn prepare_first_pair(a: &mut Self, b: &mut Self) {
-        if !(a.due && b.due) {
-            a.prepare_first();
-            b.prepare_first();
-            return;
-        }
-        debug_assert!(a.ahead_from == 0 && b.ahead_from == 0, "not new samplers");
-        let mut index_reversed = [a.index_reversed; 2 * LANES];
-        let mut seeds = ScrambleSeeds {
-            index: [0; 2 * LANES],
-            x: [0; 2 * LANES],
-            y: [0; 2 * LANES],
-        };
-        for (half, sampler) in [(0, &*a), (LANES, &*b)] {
-            let lanes = half..half + LANES;
-            seeds.index[lanes.clone()].copy_from_slice(&sampler.first_seeds.index);
-            seeds.x[lanes.clone()].copy_from_slice(&sampler.first_seeds.x);
-            seeds.y[lanes].copy_from_slice(&sampler.first_seeds.y);
-        }
-        index_reversed[LANES..].fill(b.index_reversed);
-        a.take_pair_half(b, &scrambled_sobol(&index_reversed, &seeds));
     }
 
     /// Takes the window of `a` (`self`) from the first half of `values`, `b`'s from the
@@ -460,7 +419,7 @@ impl Sampler {
 }
 
 /// Pixels whose seeds a [`SeedCache`] holds at once.
-const CACHED_PIXELS: usize = 4;
+const CACHED_PIXELS: usize = 8;
 /// Dimensions whose seeds a [`SeedCache`] holds per pixel: a path of ten bounces.
 const CACHED_DIMENSIONS: usize = 64;
 
@@ -600,8 +559,8 @@ const CAMERA_GROUPS: usize = 2 * PACKET / LANES;
 /// at once ([`CameraPoints::draw`]): Sobol's eight side by side, packed together, so that
 /// a packet's few new paths cost a few lanes' work, not a packet's, and no path waits on its
 /// own hash chain. Each sampler goes on past them, its first window (from dimension 0, the
-/// dimensions drawn here in it unused) still due, for [`Sampler::prepare_first`] once the path
-/// is known to go on: a camera ray that meets nothing computes no window.
+/// dimensions drawn here in it unused) still due, for [`Sampler::prepare_cached`] once the
+/// path is known to go on: a camera ray that meets nothing computes no window.
 pub struct CameraPoints {
     /// The camera's dimensions: 1 or 2.
     dimensions: usize,
@@ -854,13 +813,18 @@ mod tests {
     }
 
     #[test]
-    fn first_windows_from_the_pixels_seeds_draw_what_new_samplers_draw() {
-        // A pixel's samplers, their first windows computed from the scrambles' seeds they
-        // keep (alone, or two side by side of the same or of two pixels), draw what
+    fn first_windows_from_the_seed_cache_draw_what_new_samplers_draw() {
+        // A pixel's samplers, their first windows computed from the seeds their pixels put
+        // in the cache (alone, or two side by side of the same or of two pixels), draw what
         // `Sampler::new` draws, past the first window too; the independent kind is untouched.
         let draws = BOUNCE_DRAWS;
         for kind in [SAMPLER_SOBOL, SAMPLER_INDEPENDENT] {
-            let pixels = [17, 18].map(|pixel| PixelSamplers::new(kind, pixel, 9));
+            let mut cache = SeedCache::default();
+            let pixels = [17, 18].map(|pixel| {
+                let mut pixel = PixelSamplers::new(kind, pixel, 9);
+                cache.begin(&mut pixel);
+                pixel
+            });
             for (index_a, index_b, pixel_b) in [(3, 4, 0), (3, 5, 1), (0, 1 << 20, 1)] {
                 let pixel_b = &pixels[pixel_b];
                 let mut a = pixels[0].sampler(index_a);
@@ -868,8 +832,8 @@ mod tests {
                 let mut alone = pixels[0].sampler(index_a);
                 let mut new_a = Sampler::new(kind, 17, index_a, 9);
                 let mut new_b = Sampler::new(kind, pixel_b.pixel, index_b, 9);
-                Sampler::prepare_first_pair(&mut a, &mut b);
-                alone.prepare_first();
+                Sampler::prepare_pair(&mut a, &mut b, &mut cache);
+                alone.prepare_cached(&mut cache);
                 assert!(!a.window_due() && !b.window_due() && !alone.window_due());
                 for _ in 0..3 {
                     let expected = new_a.next_batch(draws);
@@ -886,13 +850,22 @@ mod tests {
         // Samplers of several pixels started over used ones (two packets' worth, the second
         // after a clear): the camera's one or two points drawn side by side are each new
         // sampler's first `next_2d`s, and the samplers go on (their first window computed
-        // from their seeds, or by the next draw) as they would have.
+        // from the seed cache, where more pixels began than it holds, or by the next draw)
+        // as they would have.
         for kind in [SAMPLER_SOBOL, SAMPLER_INDEPENDENT] {
             for dimensions in [1, 2] {
                 let mut camera = CameraPoints::new(dimensions);
+                let mut cache = SeedCache::default();
                 for round in 0..2 {
                     let count = [PACKET, 11][round];
-                    let pixel = |i: usize| PixelSamplers::new(kind, 40 + i as u32 / 3, 7);
+                    let pixels: Vec<PixelSamplers> = (0..count.div_ceil(3) as u32)
+                        .map(|p| {
+                            let mut pixel = PixelSamplers::new(kind, 40 + p, 7);
+                            cache.begin(&mut pixel);
+                            pixel
+                        })
+                        .collect();
+                    let pixel = |i: usize| pixels[i / 3];
                     let index = |i: usize| (i * 5 + round) as u32;
                     let mut samplers: Vec<Sampler> = (0..count)
                         .map(|_| {
@@ -912,7 +885,7 @@ mod tests {
                             assert_eq!(drawn, alone.next_2d(), "{kind}: sample {i}, dimension {d}");
                         }
                         let mut prepared = sampler.clone();
-                        prepared.prepare_first();
+                        prepared.prepare_cached(&mut cache);
                         for _ in 0..3 {
                             let expected = alone.next_batch(BOUNCE_DRAWS);
                             assert_eq!(sampler.next_batch(BOUNCE_DRAWS), expected, "{i}");
