@@ -172,9 +172,9 @@ pub struct RenderArgs {
     /// List the adapters found and exit.
     #[arg(long)]
     pub list_adapters: bool,
-    /// Stop after this long (`90s`, `10m`, `1.5h`) and write what was rendered, as an
-    /// interrupted render does, but exiting with status 0.
-    #[arg(long, value_name = "DURATION", value_parser = duration)]
+    /// Stop after this long (`90s`, `10m`, `1.5h`; above zero) and write what was rendered,
+    /// as an interrupted render does, but exiting with status 0.
+    #[arg(long, value_name = "DURATION", value_parser = time_limit)]
     pub time_limit: Option<Duration>,
     /// Keep the render's state in this file (written every `--checkpoint-every` and when the
     /// render stops for any reason); `--resume FILE` continues it.
@@ -422,6 +422,27 @@ pub fn duration(text: &str) -> Result<Duration, BadDuration> {
     Ok(Duration::from_secs_f64(seconds))
 }
 
+/// A time limit that is not a duration above zero (at zero a render would stop before its
+/// first sample, and write nothing).
+#[derive(Debug, thiserror::Error)]
+pub enum BadTimeLimit {
+    /// Not a duration.
+    #[error(transparent)]
+    Duration(#[from] BadDuration),
+    /// Zero.
+    #[error("{0:?}: a time limit must be above zero (a render stopped at once writes nothing)")]
+    Zero(String),
+}
+
+/// Parses a time limit: a [`duration`] above zero.
+pub fn time_limit(text: &str) -> Result<Duration, BadTimeLimit> {
+    let limit = duration(text)?;
+    if limit.is_zero() {
+        return Err(BadTimeLimit::Zero(text.to_owned()));
+    }
+    Ok(limit)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -434,6 +455,15 @@ mod tests {
         assert_eq!(duration("0.25s").unwrap(), Duration::from_millis(250));
         for bad in ["inf", "1e300", "nan", "-1", "", "m", "10x", "1e10"] {
             assert!(duration(bad).is_err(), "{bad:?} was accepted");
+            assert!(time_limit(bad).is_err(), "{bad:?} was accepted");
         }
+        assert_eq!(duration("0s").unwrap(), Duration::ZERO);
+        for zero in ["0", "0s", "0.0m", "0h"] {
+            assert!(
+                matches!(time_limit(zero), Err(BadTimeLimit::Zero(_))),
+                "{zero:?}"
+            );
+        }
+        assert_eq!(time_limit("0.5s").unwrap(), Duration::from_millis(500));
     }
 }

@@ -498,6 +498,18 @@ fn bench_and_view_refuse_bad_options() {
         );
         assert!(err.contains("positive finite number"), "{strength}:\n{err}");
     }
+    // A render's time limit of zero stopped before the first sample, wrote nothing and
+    // exited 0: now a usage error, and no file.
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("zero.png");
+    let mut args = vec!["render", "scenes/refs/furnace-0.8.toml"];
+    args.extend(SMALL_ON_CPU);
+    args.extend(["--time-limit", "0s", "-o", out.to_str().unwrap()]);
+    let output = pathlight(&args);
+    let err = stderr(&output);
+    assert_eq!(output.status.code(), Some(2), "clap's usage error\n{err}");
+    assert!(err.contains("must be above zero"), "{err}");
+    assert!(!out.exists());
     // An infinite or absurd time limit panicked converting to a Duration.
     for limit in ["inf", "1e300", "nan", "-1"] {
         let output = pathlight(&["bench", "--backend", "cpu", "--time-limit", limit]);
