@@ -423,13 +423,13 @@ const CACHED_PIXELS: usize = 8;
 /// Dimensions whose seeds a [`SeedCache`] holds per pixel: a path of ten bounces.
 const CACHED_DIMENSIONS: usize = 64;
 
-/// The scrambles' seeds of the Sobol dimensions of the last few pixels a row started (three
+/// The scrambles' seeds of the Sobol dimensions of the last eight pixels a row started (three
 /// `pcg_hash`es a dimension), computed once per pixel as its first sample to reach a window
 /// needs them, not once per sample. A sampler finds its pixel's by the slot its pixel took
-/// ([`SeedCache::begin`]); where that slot went to a newer pixel since (over
-/// [`CACHED_PIXELS`] pixels started while its path went on: a few samples a pixel), or past
-/// [`CACHED_DIMENSIONS`], the seeds are computed as before. They depend on the pixel's seed
-/// and the dimension alone: the values drawn are the same bit for bit.
+/// ([`SeedCache::begin`]); where that slot went to a newer pixel since (over eight pixels
+/// started while its path went on: a few samples a pixel), or past the 64th dimension, the
+/// seeds are computed as before. They depend on the pixel's seed and the dimension alone:
+/// the values drawn are the same bit for bit.
 #[derive(Debug, Clone)]
 pub struct SeedCache {
     pixels: [CachedSeeds; CACHED_PIXELS],
