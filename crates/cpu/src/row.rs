@@ -14,7 +14,7 @@ use crate::integrator::{
 };
 use crate::intersect::Ray;
 use crate::packet::{Lanes, PACKET, PacketHits, RayPacket};
-use crate::sampler::{CameraPoints, PixelSamplers, Sampler, SeedCache};
+use crate::sampler::{CameraPoints, PixelSamplers, SampleIndex, Sampler, SeedCache};
 use crate::tracer::Tracer;
 
 /// A row's running sums: the colour's, and the auxiliary images' (empty when the render has
@@ -284,7 +284,7 @@ struct Starter<'a> {
     /// samplers share, and the index of its next sample to start.
     column: usize,
     pixel: PixelSamplers,
-    index: u32,
+    index: SampleIndex,
     pinhole: bool,
     /// The camera's sample values of the samples starting.
     camera: CameraPoints,
@@ -309,7 +309,7 @@ impl<'a> Starter<'a> {
             width,
             column: if job.samples.is_empty() { width } else { 0 },
             pixel,
-            index: job.samples.start,
+            index: SampleIndex::new(job.samples.start),
             pinhole: params.camera.lens_radius <= 0.0,
             camera: CameraPoints::new(if params.camera.lens_radius <= 0.0 {
                 1
@@ -351,10 +351,10 @@ impl<'a> Starter<'a> {
                 self.camera.start(sampler, &self.pixel, self.index);
                 lanes.columns[l] = self.column;
                 starting |= 1 << l;
-                self.index += 1;
-                if self.index == job.samples.end {
+                self.index = self.index.next();
+                if self.index.value() == job.samples.end {
                     self.column += 1;
-                    self.index = job.samples.start;
+                    self.index = SampleIndex::new(job.samples.start);
                     if self.column != self.width {
                         let pixel = job.y * params.width + self.column as u32;
                         self.pixel = PixelSamplers::new(params.sampler, pixel, params.seed);

@@ -72,6 +72,43 @@ fn to_unit_float(x: u32) -> f32 {
     (x >> 8) as f32 * (1.0 / 16_777_216.0)
 }
 
+/// A sample's index and its bits reversed (which the Sobol scrambles read), stepped to the
+/// next index together: the increment's carry (the index's trailing ones and the zero above
+/// them) is the reversal's leading ones and the zero below them, a few instructions where a
+/// reversal is a dozen without a bit-reversal instruction (AVX2 has none).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SampleIndex {
+    value: u32,
+    reversed: u32,
+}
+
+impl SampleIndex {
+    /// Index `value`.
+    #[inline(always)]
+    pub fn new(value: u32) -> Self {
+        Self {
+            value,
+            reversed: value.reverse_bits(),
+        }
+    }
+
+    /// The index.
+    #[inline(always)]
+    pub fn value(self) -> u32 {
+        self.value
+    }
+
+    /// The next index (after `u32::MAX`, 0).
+    #[inline(always)]
+    pub fn next(self) -> Self {
+        let carry = self.reversed.leading_ones() + 1;
+        Self {
+            value: self.value.wrapping_add(1),
+            reversed: self.reversed ^ !u32::MAX.checked_shr(carry).unwrap_or(0),
+        }
+    }
+}
+
 /// How [`Sampler::next_batch`] draws one of its dimensions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Draw {
@@ -215,7 +252,7 @@ impl PixelSamplers {
             due: false,
             seed_slot: 0,
         };
-        sampler.restart(self, index);
+        sampler.restart(self, SampleIndex::new(index));
         sampler
     }
 }
@@ -230,16 +267,16 @@ impl Sampler {
     /// Makes this sampler [`PixelSamplers::sampler`]'s of `pixel` for sample `index`, its
     /// window left as it is (due: no draw reads it before it is computed anew).
     #[inline(always)]
-    pub fn restart(&mut self, pixel: &PixelSamplers, index: u32) {
+    pub fn restart(&mut self, pixel: &PixelSamplers, index: SampleIndex) {
         let sobol = pixel.kind == SAMPLER_SOBOL;
         self.kind = pixel.kind;
         self.pixel_seed = pixel.pixel_seed;
-        self.index_reversed = index.reverse_bits();
+        self.index_reversed = index.reversed;
         self.dimension = 0;
         self.rng_state = if sobol {
             0
         } else {
-            rng_init(pixel.pixel, index, pixel.seed)
+            rng_init(pixel.pixel, index.value, pixel.seed)
         };
         self.seed_slot = pixel.seed_slot;
         // The camera's dimensions and the first bounce's come from the window at 0.
@@ -603,7 +640,7 @@ impl CameraPoints {
     /// camera's points, the next ones [`CameraPoints::point`] gives. At most [`PACKET`]
     /// samplers between two [`CameraPoints::clear`]s.
     #[inline(always)]
-    pub fn start(&mut self, sampler: &mut Sampler, pixel: &PixelSamplers, index: u32) {
+    pub fn start(&mut self, sampler: &mut Sampler, pixel: &PixelSamplers, index: SampleIndex) {
         sampler.restart(pixel, index);
         for d in 0..self.dimensions {
             let (group, i) = (self.count / LANES, self.count % LANES);
@@ -668,6 +705,25 @@ mod tests {
     /// Owen scrambling from high bits to low, as written in Burley's paper.
     fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
         laine_karras(x.reverse_bits(), seed).reverse_bits()
+    }
+
+    /// Stepping an index reverses its bits as `reverse_bits` does: every index up to 2^20
+    /// stepped in turn, then around each power of two's carry and the wrap past `u32::MAX`.
+    #[test]
+    fn stepped_indices_are_reversed_as_new_ones() {
+        let mut index = SampleIndex::new(0);
+        for value in 1..=1u32 << 20 {
+            index = index.next();
+            assert_eq!(index, SampleIndex::new(value));
+        }
+        for bit in 0..32 {
+            for below in [2u32, 1, 0] {
+                let value = (1u32 << bit).wrapping_sub(below);
+                let expected = SampleIndex::new(value.wrapping_add(1));
+                assert_eq!(SampleIndex::new(value).next(), expected, "index {value}");
+            }
+        }
+        assert_eq!(SampleIndex::new(u32::MAX).next(), SampleIndex::new(0));
     }
 
     #[test]
@@ -875,7 +931,7 @@ mod tests {
                         })
                         .collect();
                     for (i, sampler) in samplers.iter_mut().enumerate() {
-                        camera.start(sampler, &pixel(i), index(i));
+                        camera.start(sampler, &pixel(i), SampleIndex::new(index(i)));
                     }
                     camera.draw(kind);
                     for (i, sampler) in samplers.iter_mut().enumerate() {
