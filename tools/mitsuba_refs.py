@@ -3,8 +3,9 @@
 
 Converts scenes/refs/NAME.toml (the subset with an exact Mitsuba equivalent: quads, spheres,
 OBJ meshes with scale + translate, emissive shapes as one-sided `area` emitters, two-sided
-diffuse, smooth or GGX-rough conductors and dielectrics with alpha = roughness^2, a
-constant environment or an `envmap` with its scale and rotation about +y, a pinhole or a
+diffuse, smooth or GGX-rough conductors and dielectrics with alpha = roughness^2, glTF's
+metal-rough metals (`principled` with metallic 1) and its diffuse base of specular strength 0,
+a constant environment or an `envmap` with its scale and rotation about +y, a pinhole or a
 `thinlens` camera, point lights, spot lights with a hard edge, directional suns) to a Mitsuba scene and either
 
   render NAME [--res 512] [--spp 1024]   writes scenes/refs/images/NAME.exr and .png: the
@@ -76,7 +77,31 @@ def schlick_white(m):
     return out
 
 
+def metal_rough(name, m):
+    """glTF's metal-rough model where Mitsuba states it exactly: a metal (metallic 1) is
+    `principled`'s metallic lobe (GGX, separable Smith, Schlick Fresnel from the base colour);
+    a dielectric of specular strength 0 is its diffuse base alone, Lambert's."""
+    plain = {"metallic", "roughness", "specular", "color", "texture", "model"}
+    if set(m) - plain:
+        raise SystemExit(f"{name}: {sorted(set(m) - plain)} of metal-rough are not converted")
+    if "texture" in m:
+        if m.get("color", [0.8] * 3) != [1.0] * 3:
+            raise SystemExit(f"{name}: a texture times a colour other than [1, 1, 1] is not converted")
+        # 8-bit images are sRGB-decoded by Mitsuba, bilinear, as pathlight does.
+        base = {"type": "bitmap", "filename": os.path.join(REFS, m["texture"]), "filter_type": "bilinear"}
+    else:
+        base = rgb(m.get("color", [0.8] * 3))
+    if m.get("metallic", 0.0) == 1.0:
+        return {"type": "principled", "base_color": base, "metallic": 1.0,
+                "roughness": m.get("roughness", 1.0), "spec_tint": 0.0}
+    if m.get("metallic", 0.0) == 0.0 and m.get("specular", 1.0) == 0.0:
+        return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": base}}
+    raise SystemExit(f"{name}: a metal-rough dielectric with specular has no exact Mitsuba equivalent")
+
+
 def bsdf(name, m):
+    if m.get("model") == "metal-rough":
+        return metal_rough(name, m)
     m = with_preset(m)
     rate = m.get("specular_rate", 0.0)
     if 0.0 < rate and m.get("refract_rate", 0.0) == 0.0 and "conductor" not in m and "eta" not in m:

@@ -22,7 +22,7 @@ use pathlight_scene::{Scene, load_scene_file};
 
 /// Mitsuba 3.9.1's own relMSE at 128x128, 64 spp, llvm_ad_rgb, mean over seeds 0-7, from
 /// `python tools/mitsuba_refs.py relmse NAME --res 128 --spp 64 --seeds 8`.
-const MITSUBA_RELMSE_128: [(&str, f64); 10] = [
+const MITSUBA_RELMSE_128: [(&str, f64); 11] = [
     ("lights", 0.016592),
     ("env-sun", 0.007424),
     ("env-sky", 0.001656),
@@ -31,6 +31,7 @@ const MITSUBA_RELMSE_128: [(&str, f64); 10] = [
     ("cornell-spheres", 0.044131),
     ("cornell-materials", 0.019095),
     ("textured-sphere", 0.004072),
+    ("gltf-metal-rough", 0.008906),
     ("furnace-0.8", 0.000347),
     ("furnace-1.0", 0.000348),
 ];
@@ -164,6 +165,13 @@ fn cornell_materials_matches_mitsuba() {
 #[test]
 fn textured_sphere_matches_mitsuba() {
     check_against_mitsuba("textured-sphere");
+}
+
+/// glTF's metal-rough model (metals with plain and textured base colours, the diffuse base
+/// alone with a texture) against Mitsuba's `principled` metal and `diffuse`.
+#[test]
+fn gltf_metal_rough_matches_mitsuba() {
+    check_against_mitsuba("gltf-metal-rough");
 }
 
 #[test]

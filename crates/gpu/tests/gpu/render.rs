@@ -208,6 +208,13 @@ fn env_sun_matches_mitsuba() {
     check_against_mitsuba("env-sun", 0.008154);
 }
 
+/// glTF's metal-rough model on the GPU: metals with plain and textured base colours, the
+/// diffuse base alone with a texture.
+#[test]
+fn gltf_metal_rough_matches_mitsuba() {
+    check_against_mitsuba("gltf-metal-rough", 0.00894);
+}
+
 /// The thin lens on the GPU.
 #[test]
 fn cornell_dof_matches_mitsuba() {
