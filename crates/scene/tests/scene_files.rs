@@ -51,8 +51,8 @@ fn shipped_scenes_load() {
         }
     }
     assert_eq!(
-        found, 27,
-        "default + outdoor + layers + instances + ten reference scenes + 13 furnace rings"
+        found, 28,
+        "default + outdoor + layers + instances + eleven reference scenes + 13 furnace rings"
     );
 }
 
