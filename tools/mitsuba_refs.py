@@ -77,6 +77,19 @@ def schlick_white(m):
     return out
 
 
+def base_color(m):
+    """The colour a material's BSDF starts from: its texture (8-bit images are sRGB-decoded by
+    Mitsuba, bilinear, as pathlight does) or its colour."""
+    if "texture" in m:
+        return {"type": "bitmap", "filename": os.path.join(REFS, m["texture"]), "filter_type": "bilinear"}
+    return rgb(m.get("color", [0.8] * 3))
+
+
+def lambert(reflectance):
+    """Mitsuba's two-sided Lambert of `reflectance`."""
+    return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": reflectance}}
+
+
 def metal_rough(name, m):
     """glTF's metal-rough model where Mitsuba states it exactly: a metal (metallic 1) is
     `principled`'s metallic lobe (GGX, separable Smith, Schlick Fresnel from the base colour);
@@ -84,19 +97,16 @@ def metal_rough(name, m):
     plain = {"metallic", "roughness", "specular", "color", "texture", "model"}
     if set(m) - plain:
         raise SystemExit(f"{name}: {sorted(set(m) - plain)} of metal-rough are not converted")
-    if "texture" in m:
-        if m.get("color", [0.8] * 3) != [1.0] * 3:
-            raise SystemExit(f"{name}: a texture times a colour other than [1, 1, 1] is not converted")
-        # 8-bit images are sRGB-decoded by Mitsuba, bilinear, as pathlight does.
-        base = {"type": "bitmap", "filename": os.path.join(REFS, m["texture"]), "filter_type": "bilinear"}
-    else:
-        base = rgb(m.get("color", [0.8] * 3))
+    if "texture" in m and m.get("color", [0.8] * 3) != [1.0] * 3:
+        raise SystemExit(f"{name}: a texture times a colour other than [1, 1, 1] is not converted")
+    base = base_color(m)
     if m.get("metallic", 0.0) == 1.0:
         return {"type": "principled", "base_color": base, "metallic": 1.0,
                 "roughness": m.get("roughness", 1.0), "spec_tint": 0.0}
     if m.get("metallic", 0.0) == 0.0 and m.get("specular", 1.0) == 0.0:
-        return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": base}}
-    raise SystemExit(f"{name}: a metal-rough dielectric with specular has no exact Mitsuba equivalent")
+        return lambert(base)
+    raise SystemExit(f"{name}: metal-rough with metallic {m.get('metallic', 0.0)} and specular "
+                     f"{m.get('specular', 1.0)} has no exact Mitsuba equivalent (metallic 1, or 0 with specular 0)")
 
 
 def bsdf(name, m):
@@ -127,12 +137,7 @@ def bsdf(name, m):
             out.update(type="roughdielectric", distribution="ggx", alpha=alpha_t)
         return out
     if m.get("specular_rate", 0.0) == 0.0 and m.get("refract_rate", 0.0) == 0.0:
-        if "texture" in m:
-            # 8-bit images are sRGB-decoded by Mitsuba, bilinear, as pathlight does.
-            reflectance = {"type": "bitmap", "filename": os.path.join(REFS, m["texture"]), "filter_type": "bilinear"}
-        else:
-            reflectance = rgb(m.get("color", [0.8] * 3))
-        return {"type": "twosided", "bsdf": {"type": "diffuse", "reflectance": reflectance}}
+        return lambert(base_color(m))
     raise SystemExit(f"material {name} has no exact Mitsuba equivalent")
 
 
