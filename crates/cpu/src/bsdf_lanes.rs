@@ -1,22 +1,23 @@
 //! The BSDF samples, and the evaluations towards light samples, of the lanes of a packet
-//! whose paths stand on one kind of material of the lobes model, computed side by side:
+//! whose paths stand on one kind of material, computed side by side:
 //! [`SampleLanes`] holds each waiting lane's vertex and runs the kind's sample and
 //! evaluation ([`LaneBsdf`]: rough glass in [`crate::glass`], rough mirrors in
-//! [`crate::glossy`]) for every lane in loops that the compiler turns into SIMD
-//! instructions, in place of a chain of dependent square roots and divisions per path. Each
-//! kind computes the one-path functions' values bit for bit (`sample_lobes`, `eval_lobes`):
-//! the same operations in the same order, the early returns turned into a validity mask.
+//! [`crate::glossy`], glTF's opaque rough materials in [`crate::metal_rough_lanes`]) for every
+//! lane in loops that the compiler turns into SIMD instructions, in place of a chain of
+//! dependent square roots and divisions per path. Each kind computes the one-path
+//! functions' values bit for bit (`sample_lobes` and `eval_lobes`, `metal_rough::sample`
+//! and `metal_rough::eval`): the same operations in the same order, the early returns
+//! turned into a validity mask.
 //! CPU only (on the GPU, threads are lanes already).
 
 use glam::{Vec2, Vec3A};
 
 use crate::light_lanes::{LightLanes, LitVertex};
 use crate::light_sample::LightSample;
-use crate::lobes::LobesParams;
 use crate::microfacet::{BsdfSample, INVALID};
 use crate::packet::{Lanes, PACKET};
 use crate::slots::{Slots, in_groups};
-use crate::soa::{Lanes3, at, dot, lane, set_lane};
+use crate::soa::{Lanes3, at, dot, frame_around, lane, set_lane, to_local};
 
 /// Waiting lanes [`SampleLanes::compute`] computes one by one rather than side by side at the
 /// AVX-512 level: with four, env-sun, cornell-materials and lights rendered 2-3% sooner than
@@ -39,6 +40,8 @@ pub struct LaneVertex {
     pub wo: [f32; 3],
     /// The material's base colour there.
     pub color: [f32; 3],
+    /// The dimension of the lobe choice.
+    pub u_lobe: f32,
     /// The dimension of the Fresnel choice.
     pub u_fresnel: f32,
     /// The dimensions of the direction.
@@ -70,11 +73,14 @@ pub struct LaneEval {
 /// A kind of material whose BSDF samples and evaluations [`SampleLanes`] computes side by
 /// side: its parameters per lane, and one lane's sample and evaluation.
 pub trait LaneBsdf: Default {
+    /// The parameters of its material model.
+    type Params;
     /// Stores lane `l`'s material parameters.
-    fn set(&mut self, l: usize, params: &LobesParams);
-    /// Lane `l`'s sample at vertex `v`: `sample_lobes`'s bit for bit.
+    fn set(&mut self, l: usize, params: &Self::Params);
+    /// Lane `l`'s sample at vertex `v`: its model's one-path sample's bit for bit.
     fn sample(&self, l: usize, v: &LaneVertex) -> LaneSample;
-    /// Lane `l`'s evaluation at vertex `v` towards `wi`: `eval_lobes`'s bit for bit.
+    /// Lane `l`'s evaluation at vertex `v` towards `wi`: its model's one-path evaluation's
+    /// bit for bit.
     fn eval(&self, l: usize, v: &LaneVertex, wi: [f32; 3]) -> LaneEval;
 }
 
@@ -109,7 +115,9 @@ pub struct SampleLanes<M> {
     ng: Lanes3,
     wo: Lanes3,
     color: Lanes3,
-    /// The dimensions of the Fresnel choice, of the direction, and of Russian roulette.
+    /// The dimensions of the lobe and the Fresnel choices, of the direction, and of Russian
+    /// roulette.
+    u_lobe: [f32; PACKET],
     u_fresnel: [f32; PACKET],
     u: [[f32; PACKET]; 2],
     u_rr: [f32; PACKET],
@@ -136,6 +144,7 @@ impl<M: Default> Default for SampleLanes<M> {
             ng: zero,
             wo: zero,
             color: zero,
+            u_lobe: [0.0; PACKET],
             u_fresnel: [0.0; PACKET],
             u: [[0.0; PACKET]; 2],
             u_rr: [0.0; PACKET],
@@ -183,8 +192,8 @@ impl<M: LaneBsdf> SampleLanes<M> {
 
     /// Lane `l` waits at `position`, on a material of parameters `params` and base colour
     /// `color`, with shading normal `ns` and geometric normal `ng` (both on the shape's
-    /// front side), seen from `wo`, with the dimensions (`u_fresnel`, `u`, `u_rr`) of its
-    /// Fresnel choice, of its direction and of Russian roulette.
+    /// front side), seen from `wo`, with the dimensions (`u_lobe`, `u_fresnel`, `u`, `u_rr`)
+    /// of its lobe and Fresnel choices, of its direction and of Russian roulette.
     #[inline(always)]
     #[expect(
         clippy::too_many_arguments,
@@ -198,8 +207,8 @@ impl<M: LaneBsdf> SampleLanes<M> {
         ng: Vec3A,
         wo: Vec3A,
         color: Vec3A,
-        params: LobesParams,
-        (u_fresnel, u, u_rr): (f32, Vec2, f32),
+        params: &M::Params,
+        (u_lobe, u_fresnel, u, u_rr): (f32, f32, Vec2, f32),
     ) {
         let k = self.slots.take(l);
         set_lane(&mut self.position, k, position);
@@ -207,7 +216,8 @@ impl<M: LaneBsdf> SampleLanes<M> {
         set_lane(&mut self.ng, k, ng);
         set_lane(&mut self.wo, k, wo);
         set_lane(&mut self.color, k, color);
-        self.model.set(k, &params);
+        self.model.set(k, params);
+        self.u_lobe[k] = u_lobe;
         self.u_fresnel[k] = u_fresnel;
         self.u[0][k] = u.x;
         self.u[1][k] = u.y;
@@ -270,6 +280,7 @@ impl<M: LaneBsdf> SampleLanes<M> {
             ng: at(&self.ng, l),
             wo: at(&self.wo, l),
             color: at(&self.color, l),
+            u_lobe: self.u_lobe[l],
             u_fresnel: self.u_fresnel[l],
             u: [self.u[0][l], self.u[1][l]],
         }
@@ -346,6 +357,34 @@ fn gathering_normal(ns: [f32; 3], ng: [f32; 3], wo: [f32; 3]) -> [f32; 3] {
     }
 }
 
+/// A vertex's normals turned to the side of `wo`, as `eval_lobes` and `metal_rough::eval`
+/// turn them, and `wo` in the frame around the shading one.
+pub(crate) struct Side {
+    /// The geometric normal.
+    pub ng: [f32; 3],
+    /// The shading normal.
+    pub n: [f32; 3],
+    /// The frame around it.
+    pub frame: [[f32; 3]; 3],
+    /// `wo` in that frame.
+    pub wo_l: [f32; 3],
+}
+
+/// The side of `v`'s `wo`.
+#[inline(always)]
+pub(crate) fn side(v: &LaneVertex) -> Side {
+    let LaneVertex { ns, ng, wo, .. } = *v;
+    let sign = if dot(wo, ng) >= 0.0 { 1.0 } else { -1.0 };
+    let n = ns.map(|c| c * sign);
+    let frame = frame_around(n);
+    Side {
+        ng: ng.map(|c| c * sign),
+        n,
+        frame,
+        wo_l: to_local(&frame, wo),
+    }
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
@@ -353,7 +392,7 @@ pub(crate) mod tests {
     use crate::environment::sample_environment;
     use crate::light_lanes::tests::assert_lit_as;
     use crate::light_sample::INVALID as INVALID_LIGHT;
-    use crate::lobes::{eval_lobes, sample_lobes};
+    use crate::microfacet::BsdfEval;
     use crate::surface::Surface;
     use pathlight_core::PreparedScene;
     use pathlight_core::gpu_types::GpuRenderParams;
@@ -374,19 +413,27 @@ pub(crate) mod tests {
         (Vec3A::new(next(), next(), next()) * 2.0 - 1.0).normalize()
     }
 
-    /// Checks that lanes of kind `M` compute `sample_lobes`'s samples bit for bit, and
-    /// `eval_lobes`'s evaluations towards light samples (two lanes in three have one: a
-    /// random direction or the lane's own sampled one, or a constant sky's sample, which
-    /// the lanes take as `sample_environment` does), over 512 packets from one lane
-    /// waiting to all, in any order: materials from `material` (given the lane and the
-    /// random numbers), random geometric normals, shading normals bent away from them and
-    /// next to -z (the frame's other branch), views from both sides, draws at 0 and next
-    /// to 1. Returns how many samples were invalid, how many valid ones `class` put in each
-    /// of its two classes, and how many evaluations were not zero.
-    pub(crate) fn assert_lanes_as_sample_lobes<M: LaneBsdf>(
+    /// A one-path BSDF sample: `sample_lobes`'s arguments.
+    pub(crate) type OnePathSample<P> = fn(&P, Vec3A, &Surface, Vec3A, f32, f32, Vec2) -> BsdfSample;
+
+    /// A one-path BSDF evaluation: `eval_lobes`'s arguments.
+    pub(crate) type OnePathEval<P> = fn(&P, Vec3A, &Surface, Vec3A, Vec3A) -> BsdfEval;
+
+    /// Checks that lanes of kind `M` compute the samples of `sample` (a model's one-path
+    /// function, such as `sample_lobes`) bit for bit, and the evaluations of `eval` (such
+    /// as `eval_lobes`) towards light samples (two lanes in three have one: a random
+    /// direction or the lane's own sampled one, or a constant sky's sample, which the lanes
+    /// take as `sample_environment` does), over 512 packets from one lane waiting to all, in
+    /// any order: materials from `material` (given the lane and the random numbers), random
+    /// geometric normals, shading normals bent away from them and next to -z (the frame's
+    /// other branch), views from both sides, draws at 0 and next to 1. Returns how many
+    /// samples were invalid, how many valid ones `class` put in each of its two classes,
+    /// and how many evaluations were not zero.
+    pub(crate) fn assert_lanes_as_one_path<M: LaneBsdf>(
         seed: u32,
-        mut material: impl FnMut(usize, &mut dyn FnMut() -> f32) -> LobesParams,
-        class: impl Fn(&BsdfSample, &LobesParams) -> bool,
+        (sample, eval): (OnePathSample<M::Params>, OnePathEval<M::Params>),
+        mut material: impl FnMut(usize, &mut dyn FnMut() -> f32) -> M::Params,
+        class: impl Fn(&BsdfSample, &M::Params) -> bool,
     ) -> [usize; 4] {
         let mut next = uniform(seed);
         let mut outcomes = [0; 4];
@@ -417,7 +464,7 @@ pub(crate) mod tests {
                 if round % 16 == 0 {
                     u = Vec2::new([0.0, 1.0f32.next_down()][l % 2], [0.0, 0.999_999_9][l / 16]);
                 }
-                let u_fresnel = next();
+                let (u_lobe, u_fresnel) = (next(), next());
                 let color = Vec3A::new(next(), next(), next());
                 let s = Surface {
                     position: (Vec3A::new(next(), next(), next()) - 0.5) * 20.0,
@@ -429,13 +476,14 @@ pub(crate) mod tests {
                     color: Vec3A::ONE,
                 };
                 let lane = (l * 7 + round) % PACKET;
-                lanes.push(lane, s.position, ns, ng, wo, color, m, (u_fresnel, u, 0.5));
-                let sample = sample_lobes(&m, color, &s, wo, 0.5, u_fresnel, u);
+                let u_all = (u_lobe, u_fresnel, u, 0.5);
+                lanes.push(lane, s.position, ns, ng, wo, color, &m, u_all);
+                let theirs = sample(&m, color, &s, wo, u_lobe, u_fresnel, u);
                 let mut sky_sample = None;
                 let light = match l % 3 {
                     0 => {
-                        let wi = if l % 2 == 0 && sample.valid {
-                            sample.wi
+                        let wi = if l % 2 == 0 && theirs.valid {
+                            theirs.wi
                         } else {
                             unit(&mut next)
                         };
@@ -444,7 +492,7 @@ pub(crate) mod tests {
                             ..INVALID_LIGHT
                         };
                         lanes.push_light(lane, &ls);
-                        Some((wi, eval_lobes(&m, color, &s, wo, wi)))
+                        Some((wi, eval(&m, color, &s, wo, wi)))
                     }
                     2 => {
                         let u_light = Vec2::new(next(), next());
@@ -452,12 +500,11 @@ pub(crate) mod tests {
                         let n = if wo.dot(ng) >= 0.0 { ns } else { -ns };
                         let ls = sample_environment(&cpu_scene, &params, n, u_light);
                         sky_sample = ls.valid.then_some(ls);
-                        ls.valid
-                            .then(|| (ls.wi, eval_lobes(&m, color, &s, wo, ls.wi)))
+                        ls.valid.then(|| (ls.wi, eval(&m, color, &s, wo, ls.wi)))
                     }
                     _ => None,
                 };
-                cases.push((m, sample, light, sky_sample));
+                cases.push((m, theirs, light, sky_sample));
             }
             // Both ways, whatever the count.
             lanes.compute([0, ONE_BY_ONE_WIDE][round % 2]);

@@ -37,6 +37,8 @@ impl Default for RoughGlass {
 }
 
 impl LaneBsdf for RoughGlass {
+    type Params = LobesParams;
+
     #[inline(always)]
     fn set(&mut self, l: usize, m: &LobesParams) {
         let alpha = m.refract_roughness * m.refract_roughness;
@@ -177,18 +179,20 @@ mod tests {
     use glam::Vec4;
 
     use super::*;
-    use crate::bsdf_lanes::tests::assert_lanes_as_sample_lobes;
+    use crate::bsdf_lanes::tests::assert_lanes_as_one_path;
+    use crate::lobes::{eval_lobes, sample_lobes};
     use crate::material::MODEL_PARAMS;
 
     /// Every lane's sample, and its evaluation towards a light sample, are `sample_lobes`'s
-    /// and `eval_lobes`'s for rough glass alone bit for bit (`assert_lanes_as_sample_lobes`): indices above and below 1 (thin films of air),
+    /// and `eval_lobes`'s for rough glass alone bit for bit (`assert_lanes_as_one_path`): indices above and below 1 (thin films of air),
     /// roughnesses from nearly smooth to 1, tints, Fresnel draws choosing each branch, total
     /// internal reflection. It fails with an operation regrouped (a quotient taken as a
     /// product by the reciprocal, a density's factors grouped otherwise).
     #[test]
     fn lanes_sample_as_sample_lobes_bit_for_bit() {
-        let outcomes = assert_lanes_as_sample_lobes::<RoughGlass>(
+        let outcomes = assert_lanes_as_one_path::<RoughGlass>(
             0x51ed_270b,
+            (sample_lobes, eval_lobes),
             |l, next| {
                 let mut block = [Vec4::ZERO; MODEL_PARAMS];
                 let ior = [1.5, 1.33, 0.75, 2.4][l % 4];

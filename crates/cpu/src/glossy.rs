@@ -6,12 +6,12 @@
 //! `ggx_reflection`, `eval_lobes` and `continuous_sample`), and a test holds each lane to
 //! `sample_lobes` and `eval_lobes`.
 
-use crate::bsdf_lanes::{LaneBsdf, LaneEval, LaneSample, LaneVertex, SampleLanes};
+use crate::bsdf_lanes::{LaneBsdf, LaneEval, LaneSample, LaneVertex, SampleLanes, Side, side};
 use crate::lobes::LobesParams;
 use crate::packet::PACKET;
 use crate::soa::{
-    Lanes3, add, at, dot, frame_around, ggx_d, ggx_g1, ggx_sample_visible, normalize, set_lane,
-    to_local, to_world,
+    Lanes3, add, at, dot, ggx_d, ggx_g1, ggx_sample_visible, max_ps, normalize, set_lane, to_local,
+    to_world,
 };
 
 /// Rough mirror lanes waiting for their BSDF samples.
@@ -41,6 +41,8 @@ impl Default for RoughMirror {
 }
 
 impl LaneBsdf for RoughMirror {
+    type Params = LobesParams;
+
     #[inline(always)]
     fn set(&mut self, l: usize, m: &LobesParams) {
         self.alpha[l] = m.specular_roughness * m.specular_roughness;
@@ -84,12 +86,6 @@ struct Fresnel {
     k: [f32; 3],
 }
 
-/// `_mm_max_ps(x, floor)`, as glam's `Vec3A::max` computes it (`floor` where `x` is NaN).
-#[inline(always)]
-fn max_ps(x: f32, floor: f32) -> f32 {
-    if x > floor { x } else { floor }
-}
-
 /// `fresnel_conductor`, one channel.
 #[inline(always)]
 fn fresnel_conductor(cos_i: f32, eta: f32, k: f32) -> f32 {
@@ -128,30 +124,6 @@ fn reflectance_channel(f: &Fresnel, cos_i: f32, schlick: f32, i: usize) -> f32 {
     let dielectric = f0 + (1.0 - f0) * schlick;
     let conductor = fresnel_conductor(cos_i, f.eta[i], f.k[i]);
     if f.conductor { conductor } else { dielectric }
-}
-
-/// A vertex's normals turned to the side of `wo`, as `eval_lobes` turns them, and `wo` in
-/// the frame around the shading one.
-struct Side {
-    ng: [f32; 3],
-    n: [f32; 3],
-    frame: [[f32; 3]; 3],
-    wo_l: [f32; 3],
-}
-
-/// The side of `v`'s `wo`.
-#[inline(always)]
-fn side(v: &LaneVertex) -> Side {
-    let LaneVertex { ns, ng, wo, .. } = *v;
-    let sign = if dot(wo, ng) >= 0.0 { 1.0 } else { -1.0 };
-    let n = ns.map(|c| c * sign);
-    let frame = frame_around(n);
-    Side {
-        ng: ng.map(|c| c * sign),
-        n,
-        frame,
-        wo_l: to_local(&frame, wo),
-    }
 }
 
 /// `sample_lobes` of a rough mirror alone: `ggx_reflection`, then `eval_lobes` (the
@@ -219,18 +191,20 @@ mod tests {
     use glam::{Vec3A, Vec4};
 
     use super::*;
-    use crate::bsdf_lanes::tests::assert_lanes_as_sample_lobes;
+    use crate::bsdf_lanes::tests::assert_lanes_as_one_path;
+    use crate::lobes::{eval_lobes, sample_lobes};
     use crate::material::MODEL_PARAMS;
 
     /// Every lane's sample, and its evaluation towards a light sample, are `sample_lobes`'s
-    /// and `eval_lobes`'s for a rough mirror alone bit for bit (`assert_lanes_as_sample_lobes`): conductors (gold, aluminium, an index with no
+    /// and `eval_lobes`'s for a rough mirror alone bit for bit (`assert_lanes_as_one_path`): conductors (gold, aluminium, an index with no
     /// absorption) and Schlick's Fresnel with any tint, roughnesses from nearly smooth to 1.
     /// It fails with any operation regrouped (a quotient taken before a product, the
     /// conductor's `eta^2 - k^2 - sin^2` summed in another order).
     #[test]
     fn lanes_sample_as_sample_lobes_bit_for_bit() {
-        let outcomes = assert_lanes_as_sample_lobes::<RoughMirror>(
+        let outcomes = assert_lanes_as_one_path::<RoughMirror>(
             0x3c6e_f372,
+            (sample_lobes, eval_lobes),
             |l, next| {
                 let mut block = [Vec4::ZERO; MODEL_PARAMS];
                 let roughness = 0.04 + 0.96 * next();

@@ -5,6 +5,7 @@ use glam::{Vec2, Vec3A};
 use pathlight_core::gpu_types::{
     GpuAccumPixel, GpuAovPixel, GpuRenderParams, KIND_QUAD, LIGHT_AREA, NO_LIGHT,
 };
+use pathlight_core::materials::MODEL_METAL_ROUGH;
 
 use crate::bsdf_lanes::{LaneBsdf, ONE_BY_ONE_WIDE, SampleLanes};
 use crate::bvh::Hit;
@@ -20,16 +21,19 @@ use crate::light_sample::LightSample;
 use crate::lights::{
     choose_light, is_delta_light, light_pdf, light_radiance, sample_light, sample_table_light,
 };
+use crate::lobes::LobesParams;
 use crate::map_lanes::{MapEscapes, sample_env_maps};
 use crate::material::{
-    eval_material, has_continuous_material_lobe, is_lambert, lobes_params, material_absorption,
+    MaterialPoint, eval_material, has_continuous_material_lobe, is_lambert, material_absorption,
     material_albedo, material_at, sample_material,
 };
+use crate::metal_rough::MetalRoughParams;
+use crate::metal_rough_lanes::MetalRoughLanes;
 use crate::microfacet::{BsdfEval, BsdfSample};
 use crate::packet::{Lanes, PACKET};
 use crate::sampler::{BOUNCE_DRAWS, Sampler};
 use crate::sampling::power_heuristic;
-use crate::surface::surface_at;
+use crate::surface::{Surface, surface_at};
 use crate::tracer::Tracer;
 
 /// Largest radiance one sample may add per channel (WGSL `SAMPLE_MAX`).
@@ -102,11 +106,15 @@ pub struct ShadingLanes {
     pub glass: GlassLanes,
     /// Rough mirror vertices (the lobes model's rough specular reflection alone).
     pub glossy: GlossyLanes,
+    /// Vertices on glTF's opaque rough materials
+    /// ([`MetalRoughParams::is_rough_opaque`]).
+    pub metal_rough: MetalRoughLanes,
     /// Bit `l` set: lane `l` (a vertex of one of the kinds above) samples the environment
     /// map at `map_u[l]`, its light sample still to be taken.
     map_lights: Lanes,
     map_u: [Vec2; PACKET],
-    /// Bit `l` set: lane `l` (a rough glass or mirror vertex) gave its kind a light sample
+    /// Bit `l` set: lane `l` (a vertex of a kind whose BSDF samples [`SampleLanes`] computes)
+    /// gave its kind a light sample
     /// taken in its step, for the kind to evaluate the BSDF towards it.
     given_lights: Lanes,
     /// What the environment map shows the lanes whose rays escaped, computed before their
@@ -123,6 +131,7 @@ impl Default for ShadingLanes {
             diffuse: DiffuseLanes::default(),
             glass: GlassLanes::default(),
             glossy: GlossyLanes::default(),
+            metal_rough: MetalRoughLanes::default(),
             map_lights: 0,
             map_u: [Vec2::ZERO; PACKET],
             given_lights: 0,
@@ -138,6 +147,7 @@ impl ShadingLanes {
         self.diffuse.clear();
         self.glass.clear();
         self.glossy.clear();
+        self.metal_rough.clear();
         self.map_lights = 0;
         self.given_lights = 0;
     }
@@ -158,8 +168,8 @@ impl ShadingLanes {
     }
 
     /// Takes the environment map's light samples left waiting
-    /// (`sample_map_lights`), then computes each kind's lanes (up to `one_by_one` rough glass
-    /// or mirror lanes one after another: [`SampleLanes::compute`]).
+    /// (`sample_map_lights`), then computes each kind's lanes (up to `one_by_one` lanes of a
+    /// kind of [`SampleLanes`] one after another: [`SampleLanes::compute`]).
     #[inline(always)]
     pub fn compute(&mut self, scene: &CpuScene, params: &GpuRenderParams, one_by_one: usize) {
         self.sample_map_lights(scene, params);
@@ -172,11 +182,14 @@ impl ShadingLanes {
         if self.glossy.mask() != 0 {
             self.glossy.compute(one_by_one);
         }
+        if self.metal_rough.mask() != 0 {
+            self.metal_rough.compute(one_by_one);
+        }
     }
 
     /// Bit `l` set: lane `l` left a light sample here for its kind to evaluate the BSDF
-    /// towards (an environment map's, or one its step took on rough glass or a rough
-    /// mirror).
+    /// towards (an environment map's, or one its step took on a vertex of a kind of
+    /// [`SampleLanes`]).
     #[inline(always)]
     pub fn lights_left(&self) -> Lanes {
         self.map_lights | self.given_lights
@@ -190,8 +203,10 @@ impl ShadingLanes {
             self.diffuse.given_light(l)
         } else if self.glass.mask() >> l & 1 != 0 {
             self.glass.light(l)
-        } else {
+        } else if self.glossy.mask() >> l & 1 != 0 {
             self.glossy.light(l)
+        } else {
+            self.metal_rough.light(l)
         }
     }
 
@@ -202,6 +217,7 @@ impl ShadingLanes {
     #[inline(always)]
     fn sample_map_lights(&mut self, scene: &CpuScene, params: &GpuRenderParams) {
         let (diffuse, glass, glossy) = (&mut self.diffuse, &mut self.glass, &mut self.glossy);
+        let metal_rough = &mut self.metal_rough;
         sample_env_maps(scene, params, self.map_lights, &self.map_u, |l, ls| {
             if !ls.valid {
                 return;
@@ -210,10 +226,83 @@ impl ShadingLanes {
                 diffuse.push_light(l, &ls);
             } else if glass.mask() >> l & 1 != 0 {
                 glass.push_light(l, &ls);
-            } else {
+            } else if glossy.mask() >> l & 1 != 0 {
                 glossy.push_light(l, &ls);
+            } else {
+                metal_rough.push_light(l, &ls);
             }
         });
+    }
+}
+
+/// A material whose vertices' BSDF samples wait for a kind of [`SampleLanes`], with its
+/// parameters.
+#[derive(Debug, Clone, Copy)]
+enum LaneKind {
+    /// Rough glass ([`LobesParams::is_rough_glass`]).
+    Glass(LobesParams),
+    /// A rough mirror ([`LobesParams::is_rough_mirror`]).
+    Glossy(LobesParams),
+    /// glTF's opaque rough material ([`MetalRoughParams::is_rough_opaque`]).
+    MetalRough(MetalRoughParams),
+}
+
+impl LaneKind {
+    /// The kind of `material` (not purely diffuse), if it has one, where the lobe choice
+    /// draws `u_lobe`: rough glass or a rough mirror of the lobes model alone, whose lobe is
+    /// the mixture's only one (`u_lobe` below its weight, 1), or glTF's opaque rough
+    /// material.
+    #[inline(always)]
+    fn of(material: &MaterialPoint, u_lobe: f32) -> Option<Self> {
+        if material.model == MODEL_METAL_ROUGH {
+            let m = MetalRoughParams::decode(&material.params);
+            return m.is_rough_opaque().then_some(Self::MetalRough(m));
+        }
+        let m = LobesParams::decode(&material.params);
+        if u_lobe >= 1.0 {
+            None
+        } else if m.is_rough_glass() {
+            Some(Self::Glass(m))
+        } else if m.is_rough_mirror() {
+            Some(Self::Glossy(m))
+        } else {
+            None
+        }
+    }
+}
+
+/// A vertex whose BSDF sample waits for the lanes of its kind, and the light sample left to
+/// them with it.
+struct WaitingVertex<'a> {
+    /// The surface point.
+    s: &'a Surface,
+    /// The direction the path arrived from.
+    wo: Vec3A,
+    /// The material's base colour there.
+    color: Vec3A,
+    /// The dimensions of the lobe and Fresnel choices, of the direction and of Russian
+    /// roulette.
+    u: (f32, f32, Vec2, f32),
+    /// A valid light sample taken in the step, for the lanes to evaluate the BSDF towards.
+    given: Option<LightSample>,
+    /// Or the constant sky's radiance, share of light samples and dimensions, for the lanes
+    /// to take its sample.
+    sky: Option<(Vec3A, f32, Vec2)>,
+}
+
+impl WaitingVertex<'_> {
+    /// Leaves the vertex to `lanes` as lane `lane`, its material's parameters `params`.
+    #[inline(always)]
+    fn wait_in<M: LaneBsdf>(&self, lanes: &mut SampleLanes<M>, lane: usize, params: &M::Params) {
+        let s = self.s;
+        lanes.push(
+            lane, s.position, s.ns, s.ng, self.wo, self.color, params, self.u,
+        );
+        if let Some(ls) = &self.given {
+            lanes.push_light(lane, ls);
+        } else if let Some((radiance, pmf, u_light)) = self.sky {
+            lanes.push_sky_light(lane, radiance, pmf, u_light);
+        }
     }
 }
 
@@ -280,11 +369,12 @@ impl Path {
     /// and the light sample of a quad, a constant sky, or a point, spot or sun light without
     /// size) is left to `diffuse` as lane `lane`: once [`DiffuseLanes::compute`] ran,
     /// [`Path::leave_diffuse`] goes on. On rough glass or a rough mirror the BSDF sample is
-    /// left to `glass` or `glossy` likewise, and [`Path::leave_sampled`] goes on. At all such vertices a light sample of the
-    /// environment map is left to `lanes` too: [`ShadingLanes::compute`] takes it and the
-    /// kind evaluates the BSDF towards it, then [`Path::left_light_test`] gives its shadow
-    /// test; on rough glass or a rough mirror so does any other light sample, taken here (a
-    /// constant sky's taken by the lanes, side by side).
+    /// left to `glass` or `glossy` likewise, on glTF's opaque rough materials to
+    /// `metal_rough`, and [`Path::leave_sampled`] goes on. At all such vertices a light
+    /// sample of the environment map is left to `lanes` too: [`ShadingLanes::compute`] takes
+    /// it and the kind evaluates the BSDF towards it, then [`Path::left_light_test`] gives
+    /// its shadow test; at those of the kinds of [`SampleLanes`] so does any other light
+    /// sample, taken here (a constant sky's taken by the lanes, side by side).
     #[inline(always)]
     pub fn step(
         &mut self,
@@ -299,6 +389,7 @@ impl Path {
             diffuse,
             glass,
             glossy,
+            metal_rough,
             map_lights,
             map_u,
             given_lights,
@@ -382,16 +473,13 @@ impl Path {
             (u_light_select.x, u_lobe.x, u_fresnel.x, u_rr.x);
         let n = if wo.dot(s.ng) >= 0.0 { s.ns } else { -s.ns };
         let lambert = is_lambert(material);
-        // Rough glass or a rough mirror alone: the lobe is the mixture's only one (u_lobe
-        // below its weight, 1); its sample waits for the lanes.
         let sampled_lanes = if lambert {
             None
         } else {
-            lobes_params(material)
-                .filter(|m| u_lobe < 1.0 && (m.is_rough_glass() || m.is_rough_mirror()))
+            LaneKind::of(material, u_lobe)
         };
         let mut shadow = None;
-        // A light sample taken here for the rough glass or mirror lanes to evaluate the BSDF
+        // A light sample taken here for the lanes of `sampled_lanes` to evaluate the BSDF
         // towards (side by side, not a chain of dependent square roots and divisions).
         let mut given = None;
         // The constant sky's sample, which those lanes take side by side.
@@ -442,28 +530,21 @@ impl Path {
             diffuse.push(lane, s.position, n, ng, wo, color, u_bsdf, u_rr);
             return shadow;
         }
-        if let Some(m) = sampled_lanes {
-            let (position, ng, color) = (s.position, s.ng, material.base_color);
-            let u = (u_fresnel, u_bsdf, u_rr);
-            if m.is_rough_glass() {
-                glass.push(lane, position, s.ns, ng, wo, color, m, u);
-            } else {
-                glossy.push(lane, position, s.ns, ng, wo, color, m, u);
+        if let Some(kind) = sampled_lanes {
+            let vertex = WaitingVertex {
+                s: &s,
+                wo,
+                color: material.base_color,
+                u: (u_lobe, u_fresnel, u_bsdf, u_rr),
+                given,
+                sky: given_sky.then(|| (Vec3A::from(params.environment), params.env_pmf, u_light)),
+            };
+            match kind {
+                LaneKind::Glass(m) => vertex.wait_in(glass, lane, &m),
+                LaneKind::Glossy(m) => vertex.wait_in(glossy, lane, &m),
+                LaneKind::MetalRough(m) => vertex.wait_in(metal_rough, lane, &m),
             }
-            if let Some(ls) = given {
-                if m.is_rough_glass() {
-                    glass.push_light(lane, &ls);
-                } else {
-                    glossy.push_light(lane, &ls);
-                }
-                *given_lights |= 1 << lane;
-            } else if given_sky {
-                let (radiance, pmf) = (Vec3A::from(params.environment), params.env_pmf);
-                if m.is_rough_glass() {
-                    glass.push_sky_light(lane, radiance, pmf, u_light);
-                } else {
-                    glossy.push_sky_light(lane, radiance, pmf, u_light);
-                }
+            if given.is_some() || given_sky {
                 *given_lights |= 1 << lane;
             }
             return shadow;
@@ -642,6 +723,9 @@ pub fn trace_path(
         }
         if lanes.glossy.mask() != 0 {
             path.leave_sampled(params, &lanes.glossy, 0);
+        }
+        if lanes.metal_rough.mask() != 0 {
+            path.leave_sampled(params, &lanes.metal_rough, 0);
         }
         if let Some(shadow) = shadow
             && !tracer.occluded(&shadow.ray, shadow.t_max)

@@ -24,6 +24,7 @@ pub mod lobes;
 pub mod map_lanes;
 pub mod material;
 pub mod metal_rough;
+pub mod metal_rough_lanes;
 pub mod microfacet;
 pub mod packet;
 pub mod point_light;

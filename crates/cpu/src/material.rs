@@ -168,12 +168,6 @@ pub fn is_lambert(p: &MaterialPoint) -> bool {
     p.model != MODEL_METAL_ROUGH && LobesParams::decode(&p.params).is_lambert()
 }
 
-/// The parameters of a material of the lobes model.
-#[inline(always)]
-pub fn lobes_params(p: &MaterialPoint) -> Option<LobesParams> {
-    (p.model != MODEL_METAL_ROUGH).then(|| LobesParams::decode(&p.params))
-}
-
 /// Whether the BSDF has a non-delta lobe (next-event estimation is worth doing). Twin of
 /// WGSL `has_continuous_material_lobe`.
 #[inline(always)]

@@ -105,6 +105,17 @@ impl MetalRoughParams {
             sheen_roughness: p[4].w,
         }
     }
+
+    /// Whether the material has neither clear coat, sheen nor transmission and is rough
+    /// (GGX alpha at least `ALPHA_MIN`): a specular lobe over a diffuse base, which
+    /// [`crate::metal_rough_lanes`] samples side by side.
+    #[inline(always)]
+    pub fn is_rough_opaque(&self) -> bool {
+        self.clearcoat <= 0.0
+            && self.sheen_color.max_element() <= 0.0
+            && self.transmission == 0.0
+            && self.roughness * self.roughness >= ALPHA_MIN
+    }
 }
 
 /// The model's texture step on block `p`: metallic times the blue and roughness times the
@@ -163,13 +174,16 @@ pub struct Lobes {
     pub diffuse: f32,
     /// Weight of the dielectric interface.
     pub wall: f32,
+    /// Weight of the dielectric's specular layer in `spec_f0` and `spec_f90` (the rest is
+    /// the metal's).
+    pub layer: f32,
     /// Schlick F0 of the dielectric's specular reflection, coloured (at most 1).
     pub f0_d: Vec3A,
     /// Its strength (`KHR_materials_specular`'s weight).
     pub specular: f32,
 }
 
-/// Twin of WGSL `mr_lobes`.
+/// The lobe weights of `m` over base colour `color`. Twin of WGSL `mr_lobes`.
 #[inline(always)]
 pub fn lobes(m: &MetalRoughParams, color: Vec3A) -> Lobes {
     let r = (m.ior - 1.0) / (m.ior + 1.0);
@@ -182,6 +196,7 @@ pub fn lobes(m: &MetalRoughParams, color: Vec3A) -> Lobes {
         spec_f90: m.metallic + layer,
         diffuse: base,
         wall: dielectric * m.transmission,
+        layer,
         f0_d,
         specular: m.specular,
     }

@@ -168,6 +168,7 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
         }
         leave_sampled(paths, &shading.glass, params);
         leave_sampled(paths, &shading.glossy, params);
+        leave_sampled(paths, &shading.metal_rough, params);
         let unblocked = shadow_tests.unblocked;
         let blocked = tracer.occluded_packet::<WIDE>(&shadows);
         // Each lane's outcome as a bit first, then a loop over each outcome's lanes: a branch

@@ -71,6 +71,12 @@ pub(crate) fn add(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     std::array::from_fn(|i| a[i] + b[i])
 }
 
+/// `_mm_max_ps(x, floor)`, as glam's `Vec3A::max` computes it (`floor` where `x` is NaN).
+#[inline(always)]
+pub(crate) fn max_ps(x: f32, floor: f32) -> f32 {
+    if x > floor { x } else { floor }
+}
+
 /// `sample_cosine_hemisphere([ux, uy])`.
 #[inline(always)]
 pub(crate) fn cosine_hemisphere(ux: f32, uy: f32) -> [f32; 3] {
