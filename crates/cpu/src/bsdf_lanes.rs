@@ -12,6 +12,7 @@
 
 use glam::{Vec2, Vec3A};
 
+use crate::cpu_scene::CpuScene;
 use crate::light_lanes::{LightLanes, LitVertex};
 use crate::light_sample::LightSample;
 use crate::microfacet::{BsdfSample, INVALID};
@@ -180,6 +181,23 @@ impl<M: LaneBsdf> SampleLanes<M> {
         self.lights.push(self.slots.slot(l), ls);
     }
 
+    /// Lane `l`, which waits ([`SampleLanes::push`]), samples quad light `object` of
+    /// `scene`, chosen with probability `pmf`, at `u_light`: [`SampleLanes::compute`] takes
+    /// that sample as `sample_area_light` would (where it is valid, the BSDF is evaluated
+    /// towards it).
+    #[inline(always)]
+    pub fn push_quad_light(
+        &mut self,
+        l: usize,
+        scene: &CpuScene,
+        object: u32,
+        pmf: f32,
+        u_light: Vec2,
+    ) {
+        self.lights
+            .push_quad(self.slots.slot(l), scene, object, pmf, u_light);
+    }
+
     /// Lane `l`, which waits ([`SampleLanes::push`]), samples the constant sky of radiance
     /// `radiance`, chosen with probability `pmf`, at `u_light`: [`SampleLanes::compute`]
     /// takes that sample as `sample_environment` would (where it is valid, the BSDF is
@@ -238,6 +256,9 @@ impl<M: LaneBsdf> SampleLanes<M> {
                 if self.lights.sky >> k & 1 != 0 {
                     self.lights.sample_sky(k, self.gathering_normal(k));
                 }
+                if self.lights.quad >> k & 1 != 0 {
+                    self.lights.sample_quad(k, at(&self.position, k));
+                }
                 if self.lights.mask >> k & 1 != 0 {
                     self.compute_light(k);
                 }
@@ -258,6 +279,10 @@ impl<M: LaneBsdf> SampleLanes<M> {
             let (ns, ng, wo) = (&self.ns, &self.ng, &self.wo);
             self.lights
                 .sample_skies::<N>(|k| gathering_normal(at(ns, k), at(ng, k), at(wo, k)));
+        }
+        if self.lights.quad != 0 {
+            let position = &self.position;
+            self.lights.sample_quads::<N>(|k| at(position, k));
         }
         if self.lights.mask != 0 {
             for k in 0..N {
@@ -388,15 +413,14 @@ pub(crate) fn side(v: &LaneVertex) -> Side {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::cpu_scene::CpuScene;
     use crate::environment::sample_environment;
     use crate::light_lanes::tests::assert_lit_as;
     use crate::light_sample::INVALID as INVALID_LIGHT;
+    use crate::lights::{choose_light, sample_table_light};
     use crate::microfacet::BsdfEval;
     use crate::surface::Surface;
     use pathlight_core::PreparedScene;
-    use pathlight_core::gpu_types::GpuRenderParams;
-    use pathlight_scene::testing::scene_of;
+    use pathlight_core::gpu_types::{GpuRenderParams, KIND_QUAD, LIGHT_AREA};
 
     /// Uniform numbers in [0, 1) (xorshift from `state`).
     pub(crate) fn uniform(mut state: u32) -> impl FnMut() -> f32 {
@@ -421,9 +445,10 @@ pub(crate) mod tests {
 
     /// Checks that lanes of kind `M` compute the samples of `sample` (a model's one-path
     /// function, such as `sample_lobes`) bit for bit, and the evaluations of `eval` (such
-    /// as `eval_lobes`) towards light samples (two lanes in three have one: a random
-    /// direction or the lane's own sampled one, or a constant sky's sample, which the lanes
-    /// take as `sample_environment` does), over 512 packets from one lane waiting to all, in
+    /// as `eval_lobes`) towards light samples (three lanes in four have one: a random
+    /// direction or the lane's own sampled one, a constant sky's sample, which the lanes
+    /// take as `sample_environment` does, or a quad light's, which they take as
+    /// `sample_area_light` does), over 512 packets from one lane waiting to all, in
     /// any order: materials from `material` (given the lane and the random numbers), random
     /// geometric normals, shading normals bent away from them and next to -z (the frame's
     /// other branch), views from both sides, draws at 0 and next to 1. Returns how many
@@ -437,7 +462,13 @@ pub(crate) mod tests {
     ) -> [usize; 4] {
         let mut next = uniform(seed);
         let mut outcomes = [0; 4];
-        let scene = scene_of(Vec::new());
+        // A scene with a quad light (cornell-materials' ceiling light; its glowing spheres
+        // are left to `Path::step`).
+        let path = format!(
+            "{}/../../scenes/refs/cornell-materials.toml",
+            env!("CARGO_MANIFEST_DIR")
+        );
+        let scene = pathlight_scene::load_scene_file(std::path::Path::new(&path)).unwrap();
         let prepared = PreparedScene::new(&scene).unwrap();
         let cpu_scene = CpuScene::new(&prepared);
         let mut params = GpuRenderParams::new(&scene.camera, &scene.settings, &prepared.shading);
@@ -479,8 +510,9 @@ pub(crate) mod tests {
                 let u_all = (u_lobe, u_fresnel, u, 0.5);
                 lanes.push(lane, s.position, ns, ng, wo, color, &m, u_all);
                 let theirs = sample(&m, color, &s, wo, u_lobe, u_fresnel, u);
-                let mut sky_sample = None;
-                let light = match l % 3 {
+                // The light sample the lanes take, where they take it.
+                let mut taken = None;
+                let light = match l % 4 {
                     0 => {
                         let wi = if l % 2 == 0 && theirs.valid {
                             theirs.wi
@@ -499,23 +531,40 @@ pub(crate) mod tests {
                         lanes.push_sky_light(lane, sky, params.env_pmf, u_light);
                         let n = if wo.dot(ng) >= 0.0 { ns } else { -ns };
                         let ls = sample_environment(&cpu_scene, &params, n, u_light);
-                        sky_sample = ls.valid.then_some(ls);
+                        taken = ls.valid.then_some(ls);
+                        ls.valid.then(|| (ls.wi, eval(&m, color, &s, wo, ls.wi)))
+                    }
+                    3 => {
+                        let (light, pmf) = loop {
+                            if let Some((light, pmf, _)) = choose_light(&cpu_scene, &params, next())
+                                && light.kind == LIGHT_AREA
+                                && cpu_scene.objects[light.index as usize].kind == KIND_QUAD
+                            {
+                                break (light, pmf);
+                            }
+                        };
+                        let u_light = Vec2::new(next(), next());
+                        lanes.push_quad_light(lane, &cpu_scene, light.index, pmf, u_light);
+                        let ls =
+                            sample_table_light(&cpu_scene, light, pmf, s.position, u_light, 0.5);
+                        taken = ls.valid.then_some(ls);
                         ls.valid.then(|| (ls.wi, eval(&m, color, &s, wo, ls.wi)))
                     }
                     _ => None,
                 };
-                cases.push((m, theirs, light, sky_sample));
+                cases.push((m, theirs, light, taken));
             }
             // Both ways, whatever the count.
             lanes.compute([0, ONE_BY_ONE_WIDE][round % 2]);
             assert_eq!(lanes.mask().count_ones() as usize, cases.len());
             let bits = |v: Vec3A| v.to_array().map(f32::to_bits);
-            for (l, (m, theirs, light, sky_sample)) in cases.iter().enumerate() {
+            for (l, (m, theirs, light, taken)) in cases.iter().enumerate() {
                 let vertex = lanes.vertex((l * 7 + round) % PACKET);
                 let ours = lanes.light((l * 7 + round) % PACKET);
-                if let (Some(ours), Some(theirs)) = (&ours, sky_sample) {
+                if let (Some(ours), Some(theirs)) = (&ours, taken) {
                     let ours = ours.light;
                     assert_eq!(ours.pdf.to_bits(), theirs.pdf.to_bits(), "lane {l}");
+                    assert_eq!(bits(ours.point), bits(theirs.point), "lane {l}");
                     assert_eq!(ours.radiance, theirs.radiance, "lane {l}");
                     assert_eq!((ours.mis, ours.finite), (theirs.mis, theirs.finite));
                     assert!(ours.map_cell.is_none());

@@ -23,7 +23,7 @@ use pathlight_core::gpu_types::{GpuLight, LIGHT_SUN};
 use crate::cpu_scene::CpuScene;
 use crate::integrator::{ShadowTest, T_MAX};
 use crate::intersect::Ray;
-use crate::light_lanes::{LightLanes, LitVertex};
+use crate::light_lanes::{LightLanes, LitVertex, QuadSample, quad_sample};
 use crate::light_sample::LightSample;
 use crate::microfacet::{BsdfSample, INVALID};
 use crate::packet::{Lanes, PACKET};
@@ -370,18 +370,14 @@ impl DiffuseLanes {
         for l in 0..N {
             let at = |a: &Lanes3| [a[0][l], a[1][l], a[2][l]];
             let p = at(&self.position);
-            let [a, b, c, normal] = self.quad.each_ref().map(at);
-            // `sample_shape` and `sample_area_light`.
-            let (ux, uy) = (self.u_light[0][l], self.u_light[1][l]);
-            let q: [f32; 3] = std::array::from_fn(|i| a[i] + ux * b[i] + uy * c[i]);
-            let density = 1.0 / self.quad_area[l];
-            let to_light: [f32; 3] = std::array::from_fn(|i| q[i] - p[i]);
-            let distance = dot(to_light, to_light).sqrt();
-            let wi = to_light.map(|v| v / distance);
-            let cos_l = dot(normal, wi.map(|v| -v));
-            let pdf = self.light_pmf[l] * density * distance * distance / cos_l;
-            // (A NaN distance or cosine makes `pdf` NaN.)
-            let sampled = distance > 0.0 && cos_l > 0.0 && pdf > 0.0 && pdf.is_finite();
+            let shape = self.quad.each_ref().map(at);
+            let u = (self.u_light[0][l], self.u_light[1][l]);
+            let QuadSample {
+                q,
+                wi,
+                pdf,
+                sampled,
+            } = quad_sample(p, shape, self.quad_area[l], self.light_pmf[l], u);
             let radiance = at(&self.emission);
             let (lit, origin, unblocked) = self.next_event(l, wi, pdf, sampled, radiance, true);
             let to_light: [f32; 3] = std::array::from_fn(|i| q[i] - origin[i]);

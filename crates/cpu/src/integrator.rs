@@ -283,27 +283,52 @@ struct WaitingVertex<'a> {
     /// The dimensions of the lobe and Fresnel choices, of the direction and of Russian
     /// roulette.
     u: (f32, f32, Vec2, f32),
-    /// A valid light sample taken in the step, for the lanes to evaluate the BSDF towards.
-    given: Option<LightSample>,
-    /// Or the constant sky's radiance, share of light samples and dimensions, for the lanes
-    /// to take its sample.
-    sky: Option<(Vec3A, f32, Vec2)>,
+    /// The light sample left to the lanes with it.
+    light: LeftLight,
 }
 
 impl WaitingVertex<'_> {
-    /// Leaves the vertex to `lanes` as lane `lane`, its material's parameters `params`.
+    /// Leaves the vertex to `lanes` as lane `lane`, its material's parameters `params` (its
+    /// light sample's in `scene`).
     #[inline(always)]
-    fn wait_in<M: LaneBsdf>(&self, lanes: &mut SampleLanes<M>, lane: usize, params: &M::Params) {
+    fn wait_in<M: LaneBsdf>(
+        &self,
+        lanes: &mut SampleLanes<M>,
+        scene: &CpuScene,
+        lane: usize,
+        params: &M::Params,
+    ) {
         let s = self.s;
         lanes.push(
             lane, s.position, s.ns, s.ng, self.wo, self.color, params, self.u,
         );
-        if let Some(ls) = &self.given {
-            lanes.push_light(lane, ls);
-        } else if let Some((radiance, pmf, u_light)) = self.sky {
-            lanes.push_sky_light(lane, radiance, pmf, u_light);
+        match self.light {
+            LeftLight::None => {}
+            LeftLight::Sample(ls) => lanes.push_light(lane, &ls),
+            LeftLight::Sky(radiance, pmf, u_light) => {
+                lanes.push_sky_light(lane, radiance, pmf, u_light);
+            }
+            LeftLight::Quad(object, pmf, u_light) => {
+                lanes.push_quad_light(lane, scene, object, pmf, u_light);
+            }
         }
     }
+}
+
+/// The light sample a vertex whose BSDF sample waits for the lanes of its kind leaves to
+/// them, for them to evaluate the BSDF towards.
+#[derive(Debug, Clone, Copy)]
+enum LeftLight {
+    /// None (or one whose BSDF `Path::step` evaluates).
+    None,
+    /// A valid light sample taken in the step.
+    Sample(LightSample),
+    /// The constant sky's, of radiance `.0`, chosen with probability `.1`, at `.2`, for the
+    /// lanes to take side by side.
+    Sky(Vec3A, f32, Vec2),
+    /// Quad light `.0`'s, chosen with probability `.1`, at `.2`, for the lanes to take side
+    /// by side.
+    Quad(u32, f32, Vec2),
 }
 
 /// One camera path in progress, between its ray queries: [`Path::ray`] is to be traced and
@@ -374,7 +399,8 @@ impl Path {
     /// sample of the environment map is left to `lanes` too: [`ShadingLanes::compute`] takes
     /// it and the kind evaluates the BSDF towards it, then [`Path::left_light_test`] gives
     /// its shadow test; at those of the kinds of [`SampleLanes`] so does any other light
-    /// sample, taken here (a constant sky's taken by the lanes, side by side).
+    /// sample, taken here (a constant sky's and a quad light's taken by the lanes, side by
+    /// side).
     #[inline(always)]
     pub fn step(
         &mut self,
@@ -479,29 +505,33 @@ impl Path {
             LaneKind::of(material, u_lobe)
         };
         let mut shadow = None;
-        // A light sample taken here for the lanes of `sampled_lanes` to evaluate the BSDF
-        // towards (side by side, not a chain of dependent square roots and divisions).
-        let mut given = None;
-        // The constant sky's sample, which those lanes take side by side.
-        let mut given_sky = false;
+        // The light sample left to the lanes of `sampled_lanes`, for them to evaluate the
+        // BSDF towards (side by side, not a chain of dependent square roots and divisions).
+        let mut left = LeftLight::None;
         if continuous {
             let choice = choose_light(scene, params, u_light_select);
             let quad = choice.filter(|(light, _, _)| {
-                lambert
+                (lambert || sampled_lanes.is_some())
                     && light.kind == LIGHT_AREA
                     && scene.objects[light.index as usize].kind == KIND_QUAD
             });
             let punctual = choice.filter(|(light, _, _)| lambert && is_delta_light(scene, light));
             let sky = u_light_select < params.env_pmf && !has_env_map(params);
             if let Some((light, pmf, _)) = quad {
-                diffuse.push_quad_light(lane, scene, light.index, pmf, u_light, self.throughput);
+                if lambert {
+                    let throughput = self.throughput;
+                    diffuse.push_quad_light(lane, scene, light.index, pmf, u_light, throughput);
+                } else {
+                    left = LeftLight::Quad(light.index, pmf, u_light);
+                }
             } else if let Some((light, pmf, _)) = punctual {
                 diffuse.push_punctual_light(lane, scene, &light, pmf, self.throughput);
             } else if sky && lambert {
                 let radiance = Vec3A::from(params.environment);
                 diffuse.push_sky_light(lane, radiance, params.env_pmf, u_light, self.throughput);
             } else if sky && sampled_lanes.is_some() {
-                given_sky = true;
+                let radiance = Vec3A::from(params.environment);
+                left = LeftLight::Sky(radiance, params.env_pmf, u_light);
             } else if (lambert || sampled_lanes.is_some())
                 && choice.is_none()
                 && u_light_select < params.env_pmf
@@ -517,7 +547,7 @@ impl Path {
                     None => sample_light(scene, params, s.position, n, u_light_select, u_light),
                 };
                 if ls.valid && sampled_lanes.is_some() {
-                    given = Some(ls);
+                    left = LeftLight::Sample(ls);
                 } else if ls.valid {
                     let e = eval_material(material, &s, wo, ls.wi);
                     shadow = self.shadow_test(scene, params, s.position, s.ng, &ls, &e);
@@ -536,15 +566,14 @@ impl Path {
                 wo,
                 color: material.base_color,
                 u: (u_lobe, u_fresnel, u_bsdf, u_rr),
-                given,
-                sky: given_sky.then(|| (Vec3A::from(params.environment), params.env_pmf, u_light)),
+                light: left,
             };
             match kind {
-                LaneKind::Glass(m) => vertex.wait_in(glass, lane, &m),
-                LaneKind::Glossy(m) => vertex.wait_in(glossy, lane, &m),
-                LaneKind::MetalRough(m) => vertex.wait_in(metal_rough, lane, &m),
+                LaneKind::Glass(m) => vertex.wait_in(glass, scene, lane, &m),
+                LaneKind::Glossy(m) => vertex.wait_in(glossy, scene, lane, &m),
+                LaneKind::MetalRough(m) => vertex.wait_in(metal_rough, scene, lane, &m),
             }
-            if given.is_some() || given_sky {
+            if !matches!(left, LeftLight::None) {
                 *given_lights |= 1 << lane;
             }
             return shadow;

@@ -1,16 +1,18 @@
 //! The light samples taken elsewhere (an environment map's) and given to the lanes of a
 //! packet that compute their BSDFs side by side ([`crate::diffuse`], [`crate::bsdf_lanes`]),
-//! or a constant sky's, taken here side by side, and the BSDF's evaluations towards them,
-//! which those lanes compute. CPU only (on the GPU, threads are lanes already).
+//! or a constant sky's or a quad light's, taken here side by side, and the BSDF's
+//! evaluations towards them, which those lanes compute. CPU only (on the GPU, threads are
+//! lanes already).
 
 use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3A};
 
+use crate::cpu_scene::CpuScene;
 use crate::light_sample::{INVALID as INVALID_LIGHT, LightSample};
 use crate::microfacet::BsdfEval;
 use crate::packet::{Lanes, PACKET};
-use crate::soa::{Lanes3, cosine_hemisphere, dot, frame_around, lane, set_lane, to_world};
+use crate::soa::{Lanes3, at, cosine_hemisphere, dot, frame_around, lane, set_lane, to_world};
 
 /// A vertex's light sample with the BSDF's evaluation towards it, computed side by side:
 /// what its shadow test needs.
@@ -39,6 +41,16 @@ pub struct LightLanes {
     /// The sky's radiance, and the probability of choosing it.
     sky_radiance: Vec3A,
     sky_pmf: f32,
+    /// Bit `l` set: lane `l`'s light sample is on a quad light, still to be taken
+    /// ([`LightLanes::push_quad`]).
+    pub quad: Lanes,
+    /// Per lane of `quad`: the quad (corner, edges, unit normal), its area, the probability
+    /// of having chosen it, its emission, and the dimensions of the point on it.
+    quads: [Lanes3; 4],
+    quad_area: [f32; PACKET],
+    quad_pmf: [f32; PACKET],
+    quad_emission: Lanes3,
+    quad_u: [[f32; PACKET]; 2],
     samples: [LightSample; PACKET],
     /// The samples' directions.
     pub wi: Lanes3,
@@ -56,6 +68,12 @@ impl Default for LightLanes {
             sky_u: [[0.0; PACKET]; 2],
             sky_radiance: Vec3A::ZERO,
             sky_pmf: 0.0,
+            quad: 0,
+            quads: [[[0.0; PACKET]; 3]; 4],
+            quad_area: [1.0; PACKET],
+            quad_pmf: [0.0; PACKET],
+            quad_emission: [[0.0; PACKET]; 3],
+            quad_u: [[0.0; PACKET]; 2],
             samples: [INVALID_LIGHT; PACKET],
             wi: [[0.0; PACKET]; 3],
             f: [[0.0; PACKET]; 3],
@@ -70,6 +88,7 @@ impl LightLanes {
     pub fn clear(&mut self) {
         self.mask = 0;
         self.sky = 0;
+        self.quad = 0;
     }
 
     /// Lane `l` has the valid light sample `ls`.
@@ -91,6 +110,90 @@ impl LightLanes {
         self.sky_u[1][l] = u.y;
         self.sky |= 1 << l;
         self.mask |= 1 << l;
+    }
+
+    /// Lane `l` samples quad light `object` of `scene`, chosen with probability `pmf`, at
+    /// `u`, as `sample_area_light` would: [`LightLanes::sample_quad`] or
+    /// [`LightLanes::sample_quads`] takes the sample.
+    #[inline(always)]
+    pub fn push_quad(&mut self, l: usize, scene: &CpuScene, object: u32, pmf: f32, u: Vec2) {
+        let o = &scene.objects[object as usize];
+        let corners = [o.a, o.b, o.c].map(|v| Vec3A::from_slice(&v));
+        for (quad, v) in self.quads.iter_mut().zip(corners) {
+            set_lane(quad, l, v);
+        }
+        set_lane(&mut self.quads[3], l, scene.quad_normal(object));
+        self.quad_area[l] = scene.quad_area(object);
+        self.quad_pmf[l] = pmf;
+        let emission = scene.materials[o.material as usize].emission;
+        set_lane(&mut self.quad_emission, l, Vec3A::from(emission));
+        self.quad_u[0][l] = u.x;
+        self.quad_u[1][l] = u.y;
+        self.quad |= 1 << l;
+        self.mask |= 1 << l;
+    }
+
+    /// Lane `l`'s quad light sample from `p`.
+    #[inline(always)]
+    fn quad_sample(&self, l: usize, p: [f32; 3]) -> QuadSample {
+        let shape = self.quads.each_ref().map(|v| at(v, l));
+        let u = (self.quad_u[0][l], self.quad_u[1][l]);
+        quad_sample(p, shape, self.quad_area[l], self.quad_pmf[l], u)
+    }
+
+    /// Takes lane `l`'s quad light sample ([`LightLanes::push_quad`]) from `p`.
+    #[inline(always)]
+    pub fn sample_quad(&mut self, l: usize, p: [f32; 3]) {
+        let s = self.quad_sample(l, p);
+        for (axis, w) in s.wi.into_iter().enumerate() {
+            self.wi[axis][l] = w;
+        }
+        self.keep_quad(l, s.q, s.pdf, s.sampled);
+    }
+
+    /// Takes the quad light samples of the first `N` lanes side by side, from the points
+    /// `p(l)` (the other lanes' light samples left as they are).
+    #[inline(always)]
+    pub fn sample_quads<const N: usize>(&mut self, p: impl Fn(usize) -> [f32; 3]) {
+        let mut q = [[0.0; N]; 3];
+        let mut pdf = [0.0; N];
+        let mut sampled = [false; N];
+        for l in 0..N {
+            let s = self.quad_sample(l, p(l));
+            let mine = self.quad >> l & 1 != 0;
+            for (axis, (row, point)) in self.wi.iter_mut().zip(&mut q).enumerate() {
+                row[l] = if mine { s.wi[axis] } else { row[l] };
+                point[l] = s.q[axis];
+            }
+            (pdf[l], sampled[l]) = (s.pdf, s.sampled);
+        }
+        let mut quad = self.quad;
+        while quad != 0 {
+            let l = quad.trailing_zeros() as usize;
+            quad &= quad - 1;
+            let point = [q[0][l], q[1][l], q[2][l]];
+            self.keep_quad(l, point, pdf[l], sampled[l]);
+        }
+    }
+
+    /// Lane `l`'s quad light sample, of direction `wi[l]`, point `q` and density `pdf`: kept
+    /// where `sampled`, else the lane has none.
+    #[inline(always)]
+    fn keep_quad(&mut self, l: usize, q: [f32; 3], pdf: f32, sampled: bool) {
+        if sampled {
+            self.samples[l] = LightSample {
+                wi: lane(&self.wi, l),
+                point: Vec3A::from(q),
+                finite: true,
+                radiance: lane(&self.quad_emission, l),
+                pdf,
+                valid: true,
+                mis: true,
+                map_cell: None,
+            };
+        } else {
+            self.mask &= !(1 << l);
+        }
     }
 
     /// The sky's direction and density for lane `l` about normal `n` (on the side light is
@@ -164,6 +267,48 @@ impl LightLanes {
             position,
             ng,
         })
+    }
+}
+
+/// A quad light's sample: the point on it, the direction towards it, the density, and
+/// whether it is valid.
+pub(crate) struct QuadSample {
+    /// The point.
+    pub q: [f32; 3],
+    /// The unit direction from the shading point towards it.
+    pub wi: [f32; 3],
+    /// The solid-angle density, with the light's choice.
+    pub pdf: f32,
+    /// Whether `sample_area_light` gives a valid sample.
+    pub sampled: bool,
+}
+
+/// `sample_shape` of a quad (corner, edges, unit normal: `shape`) of area `area` at `u`, and
+/// `sample_area_light`'s direction from `p` and density, the quad chosen with probability
+/// `pmf`.
+#[inline(always)]
+pub(crate) fn quad_sample(
+    p: [f32; 3],
+    shape: [[f32; 3]; 4],
+    area: f32,
+    pmf: f32,
+    (ux, uy): (f32, f32),
+) -> QuadSample {
+    let [a, b, c, normal] = shape;
+    let q: [f32; 3] = std::array::from_fn(|i| a[i] + ux * b[i] + uy * c[i]);
+    let density = 1.0 / area;
+    let to_light: [f32; 3] = std::array::from_fn(|i| q[i] - p[i]);
+    let distance = dot(to_light, to_light).sqrt();
+    let wi = to_light.map(|v| v / distance);
+    let cos_l = dot(normal, wi.map(|v| -v));
+    let pdf = pmf * density * distance * distance / cos_l;
+    // (A NaN distance or cosine makes `pdf` NaN.)
+    let sampled = distance > 0.0 && cos_l > 0.0 && pdf > 0.0 && pdf.is_finite();
+    QuadSample {
+        q,
+        wi,
+        pdf,
+        sampled,
     }
 }
 
