@@ -136,7 +136,9 @@ impl LightLanes {
     /// Lane `l`'s quad light sample from `p`.
     #[inline(always)]
     fn quad_sample(&self, l: usize, p: [f32; 3]) -> QuadSample {
-        let shape = self.quads.each_ref().map(|v| at(v, l));
+        // Not `array::map`, whose closure may be left out of line.
+        let q = &self.quads;
+        let shape = [at(&q[0], l), at(&q[1], l), at(&q[2], l), at(&q[3], l)];
         let u = (self.quad_u[0][l], self.quad_u[1][l]);
         quad_sample(p, shape, self.quad_area[l], self.quad_pmf[l], u)
     }
