@@ -63,6 +63,23 @@ pub struct LaneSample {
     pub eta: f32,
 }
 
+impl LaneSample {
+    /// `continuous_sample` of a reflection: direction `wi` (`sampled`: it lies where the
+    /// lobe that drew it leaves the surface) and the BSDF's evaluation there; valid where
+    /// that density is positive and finite. No interface is crossed.
+    #[inline(always)]
+    pub fn reflected(sampled: bool, wi: [f32; 3], eval: LaneEval) -> Self {
+        let LaneEval { f, pdf } = eval;
+        Self {
+            valid: sampled && pdf > 0.0 && pdf.is_finite(),
+            wi,
+            weight: f.map(|v| v / pdf),
+            pdf,
+            eta: 1.0,
+        }
+    }
+}
+
 /// One lane's BSDF evaluation: what `BsdfEval` holds.
 pub struct LaneEval {
     /// `f * |cos(wi, ns)|`.

@@ -23,7 +23,7 @@ use pathlight_core::gpu_types::{GpuLight, LIGHT_SUN};
 use crate::cpu_scene::CpuScene;
 use crate::integrator::{ShadowTest, T_MAX};
 use crate::intersect::Ray;
-use crate::light_lanes::{LightLanes, LitVertex, QuadSample, quad_sample};
+use crate::light_lanes::{LightLanes, LitVertex, QuadLanes, QuadSample};
 use crate::light_sample::LightSample;
 use crate::microfacet::{BsdfSample, INVALID};
 use crate::packet::{Lanes, PACKET};
@@ -78,8 +78,7 @@ pub struct DiffuseLanes {
     /// ([`DiffuseLanes::push_quad_light`]).
     quad_light: Lanes,
     /// The quad (corner, edges, unit normal, area).
-    quad: [Lanes3; 4],
-    quad_area: [f32; PACKET],
+    quad: QuadLanes,
     /// Bit `k` set: slot `k`'s light sample is of a point or spot light without a radius, or
     /// of a sun without a disk ([`DiffuseLanes::push_punctual_light`]), and waits too.
     punctual_light: Lanes,
@@ -126,8 +125,7 @@ impl Default for DiffuseLanes {
             sky_light: 0,
             sky_pmf: 0.0,
             quad_light: 0,
-            quad: [zero; 4],
-            quad_area: [1.0; PACKET],
+            quad: QuadLanes::default(),
             punctual_light: 0,
             sun: [false; PACKET],
             punctual: [zero; 2],
@@ -219,19 +217,9 @@ impl DiffuseLanes {
         throughput: Vec3A,
     ) {
         let k = self.slots.slot_or_take(l);
-        let o = &scene.objects[object as usize];
-        let corners = [o.a, o.b, o.c].map(|v| Vec3A::from_slice(&v));
-        for (quad, v) in self.quad.iter_mut().zip(corners) {
-            set_lane(quad, k, v);
-        }
-        set_lane(&mut self.quad[3], k, scene.quad_normal(object));
-        self.quad_area[k] = scene.quad_area(object);
+        let emission = self.quad.set(k, scene, object);
         self.light_pmf[k] = pmf;
-        set_lane(
-            &mut self.emission,
-            k,
-            Vec3A::from(scene.materials[o.material as usize].emission),
-        );
+        set_lane(&mut self.emission, k, emission);
         self.u_light[0][k] = u_light.x;
         self.u_light[1][k] = u_light.y;
         set_lane(&mut self.throughput, k, throughput);
@@ -370,14 +358,13 @@ impl DiffuseLanes {
         for l in 0..N {
             let at = |a: &Lanes3| [a[0][l], a[1][l], a[2][l]];
             let p = at(&self.position);
-            let shape = self.quad.each_ref().map(at);
             let u = (self.u_light[0][l], self.u_light[1][l]);
             let QuadSample {
                 q,
                 wi,
                 pdf,
                 sampled,
-            } = quad_sample(p, shape, self.quad_area[l], self.light_pmf[l], u);
+            } = self.quad.sample(l, p, self.light_pmf[l], u);
             let radiance = at(&self.emission);
             let (lit, origin, unblocked) = self.next_event(l, wi, pdf, sampled, radiance, true);
             let to_light: [f32; 3] = std::array::from_fn(|i| q[i] - origin[i]);

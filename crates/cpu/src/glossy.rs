@@ -139,16 +139,7 @@ fn sample_lane(v: &LaneVertex, alpha: f32, fresnel: &Fresnel) -> LaneSample {
     let wi_l: [f32; 3] = std::array::from_fn(|i| twice_cos * h[i] - wo_l[i]);
     let sampled = cos_o > 0.0 && wi_l[2] > 0.0;
     let wi = to_world(&frame, wi_l);
-    let LaneEval { f, pdf } = eval_lane(v, &side, wi, alpha, fresnel);
-    // `continuous_sample`: a direction seen lies on the side of `wo`, so no interface is
-    // crossed.
-    LaneSample {
-        valid: sampled && pdf > 0.0 && pdf.is_finite(),
-        wi,
-        weight: f.map(|v| v / pdf),
-        pdf,
-        eta: 1.0,
-    }
+    LaneSample::reflected(sampled, wi, eval_lane(v, &side, wi, alpha, fresnel))
 }
 
 /// `eval_lobes` of a rough mirror alone at `wi`: its specular lobe, with weight 1.

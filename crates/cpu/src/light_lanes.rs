@@ -44,10 +44,9 @@ pub struct LightLanes {
     /// Bit `l` set: lane `l`'s light sample is on a quad light, still to be taken
     /// ([`LightLanes::push_quad`]).
     pub quad: Lanes,
-    /// Per lane of `quad`: the quad (corner, edges, unit normal), its area, the probability
-    /// of having chosen it, its emission, and the dimensions of the point on it.
-    quads: [Lanes3; 4],
-    quad_area: [f32; PACKET],
+    /// Per lane of `quad`: the quad, the probability of having chosen it, its emission, and
+    /// the dimensions of the point on it.
+    quads: QuadLanes,
     quad_pmf: [f32; PACKET],
     quad_emission: Lanes3,
     quad_u: [[f32; PACKET]; 2],
@@ -69,8 +68,7 @@ impl Default for LightLanes {
             sky_radiance: Vec3A::ZERO,
             sky_pmf: 0.0,
             quad: 0,
-            quads: [[[0.0; PACKET]; 3]; 4],
-            quad_area: [1.0; PACKET],
+            quads: QuadLanes::default(),
             quad_pmf: [0.0; PACKET],
             quad_emission: [[0.0; PACKET]; 3],
             quad_u: [[0.0; PACKET]; 2],
@@ -117,16 +115,9 @@ impl LightLanes {
     /// [`LightLanes::sample_quads`] takes the sample.
     #[inline(always)]
     pub fn push_quad(&mut self, l: usize, scene: &CpuScene, object: u32, pmf: f32, u: Vec2) {
-        let o = &scene.objects[object as usize];
-        let corners = [o.a, o.b, o.c].map(|v| Vec3A::from_slice(&v));
-        for (quad, v) in self.quads.iter_mut().zip(corners) {
-            set_lane(quad, l, v);
-        }
-        set_lane(&mut self.quads[3], l, scene.quad_normal(object));
-        self.quad_area[l] = scene.quad_area(object);
+        let emission = self.quads.set(l, scene, object);
         self.quad_pmf[l] = pmf;
-        let emission = scene.materials[o.material as usize].emission;
-        set_lane(&mut self.quad_emission, l, Vec3A::from(emission));
+        set_lane(&mut self.quad_emission, l, emission);
         self.quad_u[0][l] = u.x;
         self.quad_u[1][l] = u.y;
         self.quad |= 1 << l;
@@ -136,11 +127,8 @@ impl LightLanes {
     /// Lane `l`'s quad light sample from `p`.
     #[inline(always)]
     fn quad_sample(&self, l: usize, p: [f32; 3]) -> QuadSample {
-        // Not `array::map`, whose closure may be left out of line.
-        let q = &self.quads;
-        let shape = [at(&q[0], l), at(&q[1], l), at(&q[2], l), at(&q[3], l)];
         let u = (self.quad_u[0][l], self.quad_u[1][l]);
-        quad_sample(p, shape, self.quad_area[l], self.quad_pmf[l], u)
+        self.quads.sample(l, p, self.quad_pmf[l], u)
     }
 
     /// Takes lane `l`'s quad light sample ([`LightLanes::push_quad`]) from `p`.
@@ -285,11 +273,51 @@ pub(crate) struct QuadSample {
     pub sampled: bool,
 }
 
+/// Per lane, a quad light: its corner, edges and unit normal, and its area.
+#[derive(Debug, Clone)]
+pub(crate) struct QuadLanes {
+    shape: [Lanes3; 4],
+    area: [f32; PACKET],
+}
+
+impl Default for QuadLanes {
+    fn default() -> Self {
+        Self {
+            shape: [[[0.0; PACKET]; 3]; 4],
+            area: [1.0; PACKET],
+        }
+    }
+}
+
+impl QuadLanes {
+    /// Lane `k` holds quad `object` of `scene`; returns the radiance the quad emits.
+    #[inline(always)]
+    pub fn set(&mut self, k: usize, scene: &CpuScene, object: u32) -> Vec3A {
+        let o = &scene.objects[object as usize];
+        let corners = [o.a, o.b, o.c].map(|v| Vec3A::from_slice(&v));
+        for (shape, v) in self.shape.iter_mut().zip(corners) {
+            set_lane(shape, k, v);
+        }
+        set_lane(&mut self.shape[3], k, scene.quad_normal(object));
+        self.area[k] = scene.quad_area(object);
+        Vec3A::from(scene.materials[o.material as usize].emission)
+    }
+
+    /// [`quad_sample`] of lane `k`'s quad from `p`, chosen with probability `pmf`, at `u`.
+    #[inline(always)]
+    pub fn sample(&self, k: usize, p: [f32; 3], pmf: f32, u: (f32, f32)) -> QuadSample {
+        // Not `array::map`, whose closure may be left out of line.
+        let q = &self.shape;
+        let shape = [at(&q[0], k), at(&q[1], k), at(&q[2], k), at(&q[3], k)];
+        quad_sample(p, shape, self.area[k], pmf, u)
+    }
+}
+
 /// `sample_shape` of a quad (corner, edges, unit normal: `shape`) of area `area` at `u`, and
 /// `sample_area_light`'s direction from `p` and density, the quad chosen with probability
 /// `pmf`.
 #[inline(always)]
-pub(crate) fn quad_sample(
+fn quad_sample(
     p: [f32; 3],
     shape: [[f32; 3]; 4],
     area: f32,

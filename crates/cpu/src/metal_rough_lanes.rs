@@ -179,16 +179,7 @@ fn sample_lane(v: &LaneVertex, w: &Weights) -> LaneSample {
         } else {
             dot(wi, ng) > 0.0
         };
-    let LaneEval { f, pdf } = eval_lane(v, &side, w, probs, wi);
-    // `continuous_sample`: a direction evaluated lies on the side of `wo`, so no interface
-    // is crossed.
-    LaneSample {
-        valid: sampled && pdf > 0.0 && pdf.is_finite(),
-        wi,
-        weight: f.map(|v| v / pdf),
-        pdf,
-        eta: 1.0,
-    }
+    LaneSample::reflected(sampled, wi, eval_lane(v, &side, w, probs, wi))
 }
 
 /// `eval_base` of an opaque rough material at `wi`, the lobes sampled with probabilities
