@@ -18,7 +18,7 @@ cd "$(dirname "$0")/.."
 
 cargo build --release --locked -p pathlight
 hot='area_light|bsdf_lanes|bvh|camera|diffuse|environment|glass|glossy|integrator|intersect'
-hot+='|light_lanes|light_sample|lights|lobes|material|metal_rough|microfacet|packet|point_light'
+hot+='|light_lanes|light_sample|lights|lobes|material|metal_rough|microfacet|packet|point_light|prefetch'
 hot+='|sampler|sampling|sheen|soa|sun_light|surface|textures|tracer'
 # Function symbols (text, weak), demangled, without their hashes: those of a hot module, or
 # of `row` but the level's choice (`InstructionSet`, `UnknownLevel`) and the per-level entry

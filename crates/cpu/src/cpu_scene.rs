@@ -10,6 +10,7 @@ use pathlight_core::gpu_types::{
 };
 
 use crate::table::Table;
+use crate::textures::srgb_to_linear;
 
 /// The light table's one entry where a scene has none (never chosen: `light_count` is 0).
 const NO_LIGHT: GpuLight = GpuLight {
@@ -57,6 +58,9 @@ pub struct CpuScene<'a> {
     pub env_guides: Table<'a, u16>,
     /// Per object: a quad's unit normal and area; zero for other kinds.
     quads: Vec<(Vec3A, f32)>,
+    /// Per 8-bit code of an sRGB colour channel, its linear value (`srgb_to_linear` of
+    /// the code over 255, bit for bit).
+    pub srgb_linear: [f32; 256],
 }
 
 impl<'a> CpuScene<'a> {
@@ -89,6 +93,9 @@ impl<'a> CpuScene<'a> {
             env_distribution: Table::new(&scene.environment.distribution, &[0.0]),
             env_guides: Table::new(&scene.environment.guides, &[0]),
             quads,
+            srgb_linear: std::array::from_fn(|code| {
+                srgb_to_linear(Vec3A::splat(code as f32 / 255.0)).x
+            }),
         }
     }
 

@@ -13,6 +13,7 @@ use pathlight_core::gpu_types::GpuRenderParams;
 
 use crate::cpu_scene::CpuScene;
 use crate::light_sample::LightSample;
+use crate::prefetch::prefetch;
 use crate::sampling::sin_cos_turns;
 use crate::sampling::{Frame, acos, atan2, first_above, sample_cosine_hemisphere};
 use crate::table::Table;
@@ -143,22 +144,6 @@ pub(crate) fn cell_color(
 #[inline(always)]
 pub fn cell_radiance(scene: &CpuScene, params: &GpuRenderParams, c: &MapCell) -> Vec3A {
     Vec3A::from(cell_color(scene.env_texels, params, c))
-}
-
-/// Asks for the cache line of `values[i]` (if any) to be loaded ahead of its use, so that
-/// its miss overlaps other work: the map's tables are megabytes, read at random.
-#[inline(always)]
-fn prefetch<T>(values: &[T], i: usize) {
-    #[cfg(target_arch = "x86_64")]
-    if let Some(value) = values.get(i) {
-        // SAFETY: a prefetch reads nothing and cannot fault; the address is `value`'s.
-        unsafe {
-            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-            _mm_prefetch::<_MM_HINT_T0>(std::ptr::from_ref(value).cast());
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = (values, i);
 }
 
 /// Probability of entry `k` of the CDF at `start` of `d`. Twin of WGSL `cdf_pmf`.

@@ -387,7 +387,8 @@ impl Path {
         }
     }
 
-    /// Goes on from `hit`, the nearest hit of [`Path::ray`], drawing from the path's
+    /// Goes on from `hit`, the nearest hit of [`Path::ray`] and the surface there
+    /// ([`surface_at`]; `None`: the ray escaped), drawing from the path's
     /// `sampler`: adds what the path sees there, samples a light (returning its shadow ray,
     /// for the caller to trace and [`Path::add_unblocked`]) and the BSDF (the next ray), or
     /// ends the path. On a purely diffuse surface the rest of the bounce (the BSDF sample,
@@ -407,7 +408,7 @@ impl Path {
         sampler: &mut Sampler,
         scene: &CpuScene,
         params: &GpuRenderParams,
-        hit: Option<Hit>,
+        hit: Option<(&Hit, &Surface)>,
         lanes: &mut ShadingLanes,
         lane: usize,
     ) -> Option<ShadowTest> {
@@ -424,7 +425,7 @@ impl Path {
         self.depth += 1;
         self.sample.rays += 1;
         let ray = self.ray;
-        let Some(hit) = hit else {
+        let Some((hit, s)) = hit else {
             let (env, pdf) = if has_env_map(params) {
                 escapes.get(lane)
             } else {
@@ -450,8 +451,7 @@ impl Path {
             return None;
         };
         sampler.prepare();
-        let s = surface_at(scene, &hit, &ray);
-        let material = &material_at(scene, &s);
+        let material = &material_at(scene, s);
         let wo = -Vec3A::from(ray.dir);
         if wo.dot(s.ng) < 0.0 {
             // The segment ran inside the object it leaves: Beer-Lambert.
@@ -549,7 +549,7 @@ impl Path {
                 if ls.valid && sampled_lanes.is_some() {
                     left = LeftLight::Sample(ls);
                 } else if ls.valid {
-                    let e = eval_material(material, &s, wo, ls.wi);
+                    let e = eval_material(material, s, wo, ls.wi);
                     shadow = self.shadow_test(scene, params, s.position, s.ng, &ls, &e);
                 }
             }
@@ -562,7 +562,7 @@ impl Path {
         }
         if let Some(kind) = sampled_lanes {
             let vertex = WaitingVertex {
-                s: &s,
+                s,
                 wo,
                 color: material.base_color,
                 u: (u_lobe, u_fresnel, u_bsdf, u_rr),
@@ -578,7 +578,7 @@ impl Path {
             }
             return shadow;
         }
-        let bs = sample_material(material, &s, wo, u_lobe, u_fresnel, u_bsdf);
+        let bs = sample_material(material, s, wo, u_lobe, u_fresnel, u_bsdf);
         self.bounce(params, &bs, s.position, s.ng, n, u_rr);
         shadow
     }
@@ -739,6 +739,8 @@ pub fn trace_path(
         lanes.clear();
         let escaped = Lanes::from(hit.is_none());
         lanes.escape(scene, params, escaped, |_| path.ray.dir.to_array());
+        let surface = hit.map(|hit| surface_at(scene, &hit, &path.ray));
+        let hit = hit.as_ref().zip(surface.as_ref());
         let mut shadow = path.step(&mut sampler, scene, params, hit, &mut lanes, 0);
         lanes.compute(scene, params, ONE_BY_ONE_WIDE);
         if lanes.lights_left() != 0 {

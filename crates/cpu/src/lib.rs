@@ -28,6 +28,7 @@ pub mod metal_rough_lanes;
 pub mod microfacet;
 pub mod packet;
 pub mod point_light;
+mod prefetch;
 mod row;
 pub mod sampler;
 pub mod sampling;

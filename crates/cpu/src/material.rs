@@ -14,7 +14,7 @@ use crate::metal_rough::{
 };
 use crate::microfacet::{BsdfEval, BsdfSample};
 use crate::surface::Surface;
-use crate::textures::{has_texture, material_texture, srgb_to_linear};
+use crate::textures::{has_texture, material_color};
 
 /// Vectors of a model's parameter block (WGSL `MODEL_PARAMS`; `material_at` loads them one
 /// by one, the last only for a material flagged `MATERIAL_LONG_BLOCK`).
@@ -55,10 +55,7 @@ pub fn material_at(scene: &CpuScene, s: &Surface) -> MaterialPoint {
     }
     let mut base_color = Vec3A::from(m.base_color) * s.color;
     if has_texture(m, TEXTURE_BASE) {
-        let texel = material_texture(scene, m, TEXTURE_BASE, uv)
-            .truncate()
-            .into();
-        base_color *= srgb_to_linear(texel);
+        base_color *= Vec3A::from(material_color(scene, m, TEXTURE_BASE, uv).truncate());
     }
     if m.model == MODEL_METAL_ROUGH {
         metal_rough_textured(scene, &mut params, m, uv);
@@ -83,10 +80,7 @@ pub fn emission_at(scene: &CpuScene, index: u32, uv: Vec2) -> Vec3A {
 fn emission(scene: &CpuScene, m: &GpuMaterial, uv: Vec2) -> Vec3A {
     let emission = Vec3A::from(m.emission);
     if has_texture(m, TEXTURE_EMISSION) {
-        let texel = material_texture(scene, m, TEXTURE_EMISSION, uv)
-            .truncate()
-            .into();
-        return emission * srgb_to_linear(texel);
+        return emission * Vec3A::from(material_color(scene, m, TEXTURE_EMISSION, uv).truncate());
     }
     emission
 }

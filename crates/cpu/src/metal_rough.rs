@@ -53,7 +53,7 @@ use crate::microfacet::{
 use crate::sampling::{Frame, sample_cone, sample_cosine_hemisphere};
 use crate::sheen::{eval_sheen, sheen_reflectance};
 use crate::surface::Surface;
-use crate::textures::{has_texture, material_texture, srgb_to_linear};
+use crate::textures::{has_texture, material_color, material_texture};
 
 /// The model's parameters: its block of the material parameters, as
 /// `pathlight_core::materials` lays it out (`metal_rough_block`), with its texture
@@ -145,8 +145,9 @@ pub fn metal_rough_textured(
         p[1].y *= texel(TEXTURE_SPECULAR).w;
     }
     if has_texture(m, TEXTURE_SPECULAR_COLOR) {
-        let c = srgb_to_linear(texel(TEXTURE_SPECULAR_COLOR).truncate().into());
-        p[2] *= c.extend(1.0);
+        p[2] *= material_color(scene, m, TEXTURE_SPECULAR_COLOR, uv)
+            .truncate()
+            .extend(1.0);
     }
     if has_texture(m, TEXTURE_CLEARCOAT) {
         p[1].z *= texel(TEXTURE_CLEARCOAT).x;
@@ -155,8 +156,9 @@ pub fn metal_rough_textured(
         p[1].w *= texel(TEXTURE_CLEARCOAT_ROUGHNESS).y;
     }
     if has_texture(m, TEXTURE_SHEEN_COLOR) {
-        let c = srgb_to_linear(texel(TEXTURE_SHEEN_COLOR).truncate().into());
-        p[4] *= c.extend(1.0);
+        p[4] *= material_color(scene, m, TEXTURE_SHEEN_COLOR, uv)
+            .truncate()
+            .extend(1.0);
     }
     if has_texture(m, TEXTURE_SHEEN_ROUGHNESS) {
         p[4].w *= texel(TEXTURE_SHEEN_ROUGHNESS).w;

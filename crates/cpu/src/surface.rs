@@ -17,7 +17,7 @@ use crate::sampling::{Frame, acos, atan2};
 use crate::textures::{has_texture, material_texture, triangle_color};
 
 /// The surface at a hit. Twin of WGSL `Surface`.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 pub struct Surface {
     /// World position.
     pub position: Vec3A,

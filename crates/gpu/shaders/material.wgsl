@@ -44,7 +44,7 @@ fn material_at(s: Surface) -> MaterialPoint {
     }
     var base_color = m.base_color * s.color;
     if has_texture(m, TEXTURE_BASE) {
-        base_color *= srgb_to_linear(material_texture(m, TEXTURE_BASE, uv).rgb);
+        base_color *= material_color(m, TEXTURE_BASE, uv).rgb;
     }
     if METAL_ROUGH && m.model == MODEL_METAL_ROUGH {
         metal_rough_textured(&params, m, uv);
@@ -57,7 +57,7 @@ fn material_at(s: Surface) -> MaterialPoint {
 fn emission_at(index: u32, uv: vec2f) -> vec3f {
     let m = materials[index];
     if has_texture(m, TEXTURE_EMISSION) {
-        return m.emission * srgb_to_linear(material_texture(m, TEXTURE_EMISSION, uv).rgb);
+        return m.emission * material_color(m, TEXTURE_EMISSION, uv).rgb;
     }
     return m.emission;
 }

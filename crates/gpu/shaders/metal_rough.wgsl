@@ -65,7 +65,7 @@ fn metal_rough_textured(p: ptr<function, array<vec4f, MODEL_PARAMS>>, m: Materia
         (*p)[1].y *= material_texture(m, TEXTURE_SPECULAR, uv).a;
     }
     if has_texture(m, TEXTURE_SPECULAR_COLOR) {
-        (*p)[2] *= vec4f(srgb_to_linear(material_texture(m, TEXTURE_SPECULAR_COLOR, uv).rgb), 1.0);
+        (*p)[2] *= vec4f(material_color(m, TEXTURE_SPECULAR_COLOR, uv).rgb, 1.0);
     }
     if has_texture(m, TEXTURE_CLEARCOAT) {
         (*p)[1].z *= material_texture(m, TEXTURE_CLEARCOAT, uv).r;
@@ -74,7 +74,7 @@ fn metal_rough_textured(p: ptr<function, array<vec4f, MODEL_PARAMS>>, m: Materia
         (*p)[1].w *= material_texture(m, TEXTURE_CLEARCOAT_ROUGHNESS, uv).g;
     }
     if has_texture(m, TEXTURE_SHEEN_COLOR) {
-        (*p)[4] *= vec4f(srgb_to_linear(material_texture(m, TEXTURE_SHEEN_COLOR, uv).rgb), 1.0);
+        (*p)[4] *= vec4f(material_color(m, TEXTURE_SHEEN_COLOR, uv).rgb, 1.0);
     }
     if has_texture(m, TEXTURE_SHEEN_ROUGHNESS) {
         (*p)[4].w *= material_texture(m, TEXTURE_SHEEN_ROUGHNESS, uv).a;

@@ -10,9 +10,14 @@ fn srgb_to_linear(c: vec3f) -> vec3f {
     return select(high, low, c <= vec3f(0.04045));
 }
 
+// The texel's channels in [0, 1], its colour decoded from sRGB where `srgb`.
 // CPU twin: `texel`.
-fn texel(slot: TextureSlot, x: u32, y: u32) -> vec4f {
-    return unpack4x8unorm(texels[slot.offset + y * slot.width + x]);
+fn texel(slot: TextureSlot, x: u32, y: u32, srgb: bool) -> vec4f {
+    let c = unpack4x8unorm(texels[slot.offset + y * slot.width + x]);
+    if srgb {
+        return vec4f(srgb_to_linear(c.rgb), c.a);
+    }
+    return c;
 }
 
 // A coordinate folded into [0, 1] by wrap mode `mode`.
@@ -37,9 +42,10 @@ fn texel_index(i: f32, n: u32, mode: u32) -> u32 {
     return u32(clamp(i, 0.0, f32(n) - 1.0));
 }
 
-// Bilinear RGBA lookup, as stored (sRGB colour channels are not decoded); row 0 is v = 0.
+// Bilinear RGBA lookup, each texel's colour decoded from sRGB before the filter where
+// `srgb` (as sRGB texture formats filter), else as stored; row 0 is v = 0.
 // CPU twin: `sample_slot`.
-fn sample_slot(slot: TextureSlot, uv: vec2f) -> vec4f {
+fn sample_slot(slot: TextureSlot, uv: vec2f, srgb: bool) -> vec4f {
     let mode_u = slot.wrap & 3u;
     let mode_v = (slot.wrap >> 2u) & 3u;
     let t = vec2f(dot(slot.u.xy, uv) + slot.u.z, dot(slot.v.xy, uv) + slot.v.z);
@@ -51,8 +57,8 @@ fn sample_slot(slot: TextureSlot, uv: vec2f) -> vec4f {
     let x1 = texel_index(base.x + 1.0, slot.width, mode_u);
     let y0 = texel_index(base.y, slot.height, mode_v);
     let y1 = texel_index(base.y + 1.0, slot.height, mode_v);
-    let top = mix(texel(slot, x0, y0), texel(slot, x1, y0), f.x);
-    let bottom = mix(texel(slot, x0, y1), texel(slot, x1, y1), f.x);
+    let top = mix(texel(slot, x0, y0, srgb), texel(slot, x1, y0, srgb), f.x);
+    let bottom = mix(texel(slot, x0, y1, srgb), texel(slot, x1, y1, srgb), f.x);
     return mix(top, bottom, f.y);
 }
 
@@ -62,10 +68,17 @@ fn has_texture(m: Material, which: u32) -> bool {
     return TEXTURES && ((m.texture_mask >> which) & 1u) != 0u;
 }
 
-// Material `m`'s texture `which` (a TEXTURE_* it has) at `uv`.
+// Material `m`'s texture `which` (a TEXTURE_* it has) at `uv`, as stored (linear data).
 // CPU twin: `material_texture`.
 fn material_texture(m: Material, which: u32, uv: vec2f) -> vec4f {
-    return sample_slot(texture_slots[m.textures + which], uv);
+    return sample_slot(texture_slots[m.textures + which], uv, false);
+}
+
+// Material `m`'s colour texture `which` (a TEXTURE_* it has, sRGB-encoded) at `uv`: linear
+// RGB, alpha as stored.
+// CPU twin: `material_color`.
+fn material_color(m: Material, which: u32, uv: vec2f) -> vec4f {
+    return sample_slot(texture_slots[m.textures + which], uv, true);
 }
 
 // Texture coordinates at barycentrics (b1, b2) of triangle `triangle`.

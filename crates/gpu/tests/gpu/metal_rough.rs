@@ -517,6 +517,52 @@ fn the_extensions_textures_multiply_their_factors_on_both_backends() {
     );
 }
 
+/// A base colour texture is decoded from sRGB texel by texel before its bilinear filter, as
+/// sRGB texture formats and Mitsuba's bitmap texture filter: a sphere under a sky of
+/// radiance 1, textured with black and white texels in turn (a stripe each, 256 around it,
+/// two to eight a pixel), renders as the same sphere of base colour 0.5 without a texture
+/// (the filter's mean between the texels; image means within 1%, on each backend), and not
+/// as one of the mean of sRGB's curve over [0, 1] (0.31), which a filter before the
+/// decoding gives.
+#[test]
+fn srgb_textures_are_filtered_in_linear_light_on_both_backends() {
+    let sphere = |color: f32, texture: bool| {
+        let mut s = scene("refs/furnace-1.0.toml", 64, 16, 2);
+        s.materials[0] = metal_rough("sphere", Vec3::splat(color), MetalRough::DEFAULT);
+        if texture {
+            s.materials[0].texture = Some(TextureRef {
+                texture: 0,
+                transform: TextureRef::IDENTITY,
+                wrap: [Wrap::Repeat; 2],
+            });
+            s.textures = vec![strip(256, |x| {
+                let v = if x % 2 == 0 { 0 } else { 255 };
+                [v, v, v, 255]
+            })];
+        }
+        s
+    };
+    let srgb_curve_mean = 0.31;
+    for (backend, render) in [("CPU", render_cpu as fn(&Scene) -> Film), ("GPU", render)] {
+        let mean = |s: &Scene| render(s).mean()[1];
+        let textured = mean(&sphere(1.0, true));
+        let flat = mean(&sphere(0.5, false));
+        let filtered_before_decoding = mean(&sphere(srgb_curve_mean, false));
+        println!(
+            "{backend}: textured {textured:.4}, base 0.5 {flat:.4}, base {srgb_curve_mean} \
+             {filtered_before_decoding:.4}"
+        );
+        assert!(
+            (textured - flat).abs() <= 0.01 * flat,
+            "{backend}: the textured sphere's mean {textured} is not base 0.5's {flat}"
+        );
+        assert!(
+            (filtered_before_decoding - flat).abs() > 0.05 * flat,
+            "{backend}: the test cannot tell the filters apart"
+        );
+    }
+}
+
 /// Vertex colours (`COLOR_0`) multiply the base colour: a white quad whose corners carry a
 /// colour shades as a quad of that base colour (99% of pixels within 2%, CPU and GPU), and a
 /// quad whose colour runs from black to white across it is dark on one side and bright on
