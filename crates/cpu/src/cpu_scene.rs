@@ -61,6 +61,8 @@ pub struct CpuScene<'a> {
     /// Per 8-bit code of an sRGB colour channel, its linear value (`srgb_to_linear` of
     /// the code over 255, bit for bit).
     pub srgb_linear: [f32; 256],
+    /// Whether a material has a texture.
+    pub textured: bool,
 }
 
 impl<'a> CpuScene<'a> {
@@ -93,6 +95,7 @@ impl<'a> CpuScene<'a> {
             env_distribution: Table::new(&scene.environment.distribution, &[0.0]),
             env_guides: Table::new(&scene.environment.guides, &[0]),
             quads,
+            textured: scene.shading.materials.iter().any(|m| m.texture_mask != 0),
             srgb_linear: std::array::from_fn(|code| {
                 srgb_to_linear(Vec3A::splat(code as f32 / 255.0)).x
             }),

@@ -133,10 +133,12 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
             packet: &mut shadows,
             unblocked: [Vec3A::ZERO; PACKET],
         };
-        // The surfaces the hits lie on, their textures' texels asked for together: on a
-        // texture of megabytes the bounces' lookups miss the caches, and a packet's misses
-        // overlap so instead of each stalling its step.
-        let mut left = occupied & found;
+        // In a scene with textures, the surfaces the hits lie on first, their textures' texels
+        // asked for together: on a texture of megabytes the bounces' lookups miss the caches,
+        // and a packet's misses overlap so instead of each stalling its step (textured-sphere
+        // 12% sooner). Elsewhere each step computes its surface (the pass's copies cost 2% of
+        // cornell-materials' instructions).
+        let mut left = if scene.textured { occupied & found } else { 0 };
         while left != 0 {
             let l = left.trailing_zeros() as usize;
             left &= left - 1;
@@ -158,7 +160,12 @@ fn render_row<const WIDE: bool>(tracer: &mut Tracer, job: &RowJob, row: &mut Row
             let l = left.trailing_zeros() as usize;
             left &= left - 1;
             let (sampler, hit) = (&mut samplers[l], hits.nearest(l));
-            let at = Some((&hit, &surfaces[l]));
+            let surface = if scene.textured {
+                surfaces[l]
+            } else {
+                surface_at(scene, &hit, &paths[l].ray)
+            };
+            let at = Some((&hit, &surface));
             let shadow = paths[l].step(sampler, scene, params, at, &mut shading, l);
             shadow_tests.add(l, shadow);
         }
