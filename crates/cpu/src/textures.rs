@@ -57,7 +57,7 @@ fn wrap(x: f32, mode: u32) -> f32 {
 
 /// Twin of WGSL `texel_index`, its `%` taken by at most two subtractions instead of a
 /// division: the same index for every `i` that [`taps`] gives (a corner in [-1, n], or not
-/// a number), where `(i + n) as i32` lies in [n - 1, 2n] (0 for not a number).
+/// a number), where `(i + n) as u32` lies in [n - 1, 2n] (0 for not a number).
 #[inline(always)]
 fn texel_index(i: f32, n: u32, mode: u32) -> u32 {
     if mode == WRAP_REPEAT {
